@@ -1,0 +1,3 @@
+"""clearsim: planar mechanisms with clearance joints."""
+
+__version__ = "0.1.0"

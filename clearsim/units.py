@@ -1,0 +1,154 @@
+"""Unit strings ("0.01 mm", "5000 rpm", "30 deg") to SI floats, once, at load time.
+
+A bare number is taken as SI (metre, kilogram, second, radian). Angles are
+dimensionless in SI, so "30 deg" and "0.52" are both accepted where an angle is
+expected, and "5000 rpm" converts to rad/s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Annotated, Any
+
+from pydantic import BeforeValidator, WithJsonSchema
+
+
+class UnitError(ValueError):
+    """A value whose unit is unknown or of the wrong kind."""
+
+
+@lru_cache(maxsize=1)
+def registry():
+    """The shared pint registry (created on first use: it takes a few tenths of a second)."""
+    import pint
+
+    return pint.UnitRegistry()
+
+
+@dataclass(frozen=True)
+class Dimension:
+    """A physical kind, named for messages, with its SI unit and pint dimensionality."""
+
+    name: str
+    si_unit: str
+    exponents: tuple[tuple[str, float], ...]
+    example: str
+
+
+def _dims(**exponents: float) -> tuple[tuple[str, float], ...]:
+    return tuple(sorted((f"[{k}]", float(v)) for k, v in exponents.items() if v))
+
+
+DIMENSIONS = {
+    "length": Dimension("length", "m", _dims(length=1), "0.01 mm"),
+    "mass": Dimension("mass", "kg", _dims(mass=1), "3.67 kg"),
+    "inertia": Dimension("moment of inertia", "kg*m^2", _dims(mass=1, length=2), "0.044 kg*m^2"),
+    "time": Dimension("time", "s", _dims(time=1), "85 ms"),
+    "frequency": Dimension("frequency", "Hz", _dims(time=-1), "100 kHz"),
+    "speed": Dimension("speed", "m/s", _dims(length=1, time=-1), "1e-4 m/s"),
+    "acceleration": Dimension("acceleration", "m/s^2", _dims(length=1, time=-2), "-9.81 m/s^2"),
+    "angle": Dimension("angle", "rad", (), "30 deg"),
+    "angular_speed": Dimension("angular speed", "rad/s", _dims(time=-1), "5000 rpm"),
+    "force": Dimension("force", "N", _dims(mass=1, length=1, time=-2), "100 N"),
+    "torque": Dimension("torque", "N*m", _dims(mass=1, length=2, time=-2), "20 N*m"),
+    "pressure": Dimension("pressure (modulus)", "Pa", _dims(mass=1, length=-1, time=-2), "207 GPa"),
+    "spring_stiffness": Dimension("spring stiffness", "N/m", _dims(mass=1, time=-2), "1e5 N/m"),
+    "damping": Dimension("damping coefficient", "N*s/m", _dims(mass=1, time=-1), "50 N*s/m"),
+    "dimensionless": Dimension("dimensionless number", "1", (), "0.2"),
+}
+
+
+def _dimensionality(quantity) -> tuple[tuple[str, float], ...]:
+    return tuple(sorted((k, float(v)) for k, v in dict(quantity.dimensionality).items() if v))
+
+
+def parse_quantity(value: Any):
+    """A pint quantity from a number or a "value unit" string; UnitError names what is wrong."""
+    if isinstance(value, bool):
+        raise UnitError(f"expected a number with a unit, got {value!r}")
+    if isinstance(value, (int, float)):
+        return registry().Quantity(float(value))
+    if not isinstance(value, str):
+        raise UnitError(f"expected a number or a 'value unit' string, got {value!r}")
+    import pint
+
+    try:
+        quantity = registry().Quantity(value.strip())
+    except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError) as exc:
+        raise UnitError(f"unknown unit in {value!r} ({exc})") from None
+    except Exception:
+        raise UnitError(f"cannot read {value!r} as 'value unit' (e.g. '0.01 mm')") from None
+    if not hasattr(quantity, "magnitude") or not isinstance(quantity.magnitude, (int, float)):
+        raise UnitError(f"cannot read {value!r} as a number with a unit")
+    return quantity
+
+
+def _has_unit(quantity) -> bool:
+    return str(quantity.units) != "dimensionless"
+
+
+def to_si(value: Any, kind: str) -> float:
+    """The SI magnitude of `value`, which must be of physical kind `kind` (a key of DIMENSIONS)."""
+    dimension = DIMENSIONS[kind]
+    quantity = parse_quantity(value)
+    if not _dimensionality(quantity) and not _has_unit(quantity):
+        return float(quantity.magnitude)  # a bare number is SI
+    if _dimensionality(quantity) != dimension.exponents:
+        found = f"{quantity.units:~}" or "no unit"
+        raise UnitError(
+            f"expected a {dimension.name} (e.g. '{dimension.example}'), got {value!r} [{found}]"
+        )
+    return float(quantity.to_base_units().magnitude)
+
+
+def contact_stiffness_to_si(value: Any, exponent: float) -> float:
+    """SI magnitude of a contact stiffness K of F = K δⁿ, in N/m^n (dimension checked against n)."""
+    quantity = parse_quantity(value)
+    expected = _dims(mass=1, length=1 - exponent, time=-2)
+    if _has_unit(quantity) and _dimensionality(quantity) != expected:
+        raise UnitError(
+            f"expected a contact stiffness in N/m^{exponent:g} for exponent n = {exponent:g}, got {value!r}"
+        )
+    return float(quantity.to_base_units().magnitude)
+
+
+def _si_validator(kind: str):
+    def convert(value: Any) -> float:
+        try:
+            return to_si(value, kind)
+        except UnitError as exc:
+            raise ValueError(str(exc)) from None
+
+    return convert
+
+
+def _quantity_type(kind: str):
+    dimension = DIMENSIONS[kind]
+    return Annotated[
+        float,
+        BeforeValidator(_si_validator(kind)),
+        WithJsonSchema(
+            {
+                "anyOf": [{"type": "number"}, {"type": "string"}],
+                "description": f"{dimension.name}: a number in {dimension.si_unit} or a string with a unit, e.g. '{dimension.example}'",
+            }
+        ),
+    ]
+
+
+Length = _quantity_type("length")
+Mass = _quantity_type("mass")
+Inertia = _quantity_type("inertia")
+Time = _quantity_type("time")
+Frequency = _quantity_type("frequency")
+Speed = _quantity_type("speed")
+Acceleration = _quantity_type("acceleration")
+Angle = _quantity_type("angle")
+AngularSpeed = _quantity_type("angular_speed")
+Force = _quantity_type("force")
+Torque = _quantity_type("torque")
+Pressure = _quantity_type("pressure")
+SpringStiffness = _quantity_type("spring_stiffness")
+Damping = _quantity_type("damping")
+Number = _quantity_type("dimensionless")

@@ -1,0 +1,1 @@
+"""Reference solutions shared by unit and validation tests."""

@@ -49,7 +49,7 @@ def hysteresis_factor(law, restitution):
 
 @njit(cache=True)
 def normal_force(law, penetration, penetration_rate, impact_speed, stiffness, exponent, restitution):
-    """F_n = K δⁿ (1 + D(c_e) δ̇/δ̇⁻) for δ > 0, else 0 (Meng 2015 eq. 11 for D = 3(1−c_e²)/4)."""
+    """F_n = K δⁿ (1 + D(c_e) δ̇/δ̇⁻) for δ > 0, else 0 (Meng 2015 eq. 11 with D = 3(1−c_e²)/4)."""
     if penetration <= 0.0:
         return 0.0
     damping = hysteresis_factor(law, restitution) * penetration_rate / impact_speed
@@ -102,7 +102,7 @@ def hertz_max_penetration(effective_mass, stiffness, impact_speed, exponent=1.5)
 
 
 def hertz_peak_force(effective_mass, stiffness, impact_speed, exponent=1.5):
-    """F_max = K δ_max^n of an undamped Hertz impact (Hertz 1882; Johnson, Contact Mechanics 1985, ch. 11)."""
+    """F_max = K δ_max^n of an undamped impact (Hertz 1882; Johnson, Contact Mechanics 1985, ch. 11)."""
     return stiffness * hertz_max_penetration(effective_mass, stiffness, impact_speed, exponent) ** exponent
 
 

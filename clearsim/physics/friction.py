@@ -33,7 +33,7 @@ def _sign(value):
 
 @njit(cache=True)
 def step_blend(x, x0, h0, x1, h1):
-    """Adams STEP: h0 + (h1 − h0) Δ²(3 − 2Δ), Δ = (x − x0)/(x1 − x0), held at h0/h1 outside [x0, x1]."""
+    """Adams STEP, h0 + (h1 − h0) Δ²(3 − 2Δ) with Δ = (x − x0)/(x1 − x0), held outside [x0, x1]."""
     if x <= x0:
         return h0
     if x >= x1:

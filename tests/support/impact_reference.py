@@ -75,7 +75,8 @@ def _peak_force(force, dense, contact_time):
     return max(-refined.fun, force_at(times[best]))
 
 
-def law_impact(law, restitution, stiffness=1.0e10, mass=1.0, impact_speed=1.0, exponent=1.5, rtol=1e-12):
+def law_impact(law, restitution, stiffness=1.0e10, mass=1.0, impact_speed=1.0, exponent=1.5,
+               rtol=1e-12):
     """One impact under a clearsim contact law (a CONTACT_LAWS code), SI units."""
 
     def force(penetration, penetration_rate):

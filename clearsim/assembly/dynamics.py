@@ -1,0 +1,213 @@
+"""Equations of motion and constraint stabilisation (compiled).
+
+M q̈ + Φ_qᵀ λ = Q (Meng 2015 eq. 14/15) with Φ_q q̈ = γ. M is diagonal (m, m, J per body),
+so λ comes from the Schur complement S λ = Φ_q M⁻¹ Q − γ, S = Φ_q M⁻¹ Φ_qᵀ (symmetric
+positive definite when no constraint is redundant, which assembly checks), then
+q̈ = M⁻¹ (Q − Φ_qᵀ λ). After each step the state is projected onto Φ = 0 and Φ_q q̇ = ν
+in the kinetic-energy metric M (the projection method of Hairer, Lubich & Wanner,
+Geometric Numerical Integration, §IV.4), which keeps ‖Φ‖ at round-off level.
+
+The state vector is y = [q, q̇, W], W the integrated powers (WORK_* below).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from clearsim.assembly.constraints import (
+    constraint_count, evaluate_acceleration_rhs, evaluate_constraints, evaluate_jacobian,
+    evaluate_velocity_rhs, prescribed,
+)
+from clearsim.assembly.forces import (
+    add_applied_forces, add_clearance_forces, add_global_force, clearance_kinematics,
+)
+from clearsim.assembly.kinematics import point_position
+from clearsim.assembly.arrays import CL_BEARING_POINT
+
+WORK_DRIVER = 0
+WORK_CONTACT = 1
+WORK_FRICTION = 2
+WORK_DAMPING = 3
+WORK_APPLIED = 4
+WORK_COUNT = 5
+
+
+@njit(cache=True)
+def coordinate_count(system):
+    return 3 * system.mass.shape[0]
+
+
+@njit(cache=True)
+def inverse_mass(system):
+    """Diagonal of M⁻¹."""
+    nb = system.mass.shape[0]
+    minv = np.empty(3 * nb)
+    for b in range(nb):
+        minv[3 * b] = 1.0 / system.mass[b]
+        minv[3 * b + 1] = 1.0 / system.mass[b]
+        minv[3 * b + 2] = 1.0 / system.inertia[b]
+    return minv
+
+
+@njit(cache=True)
+def cholesky_solve(matrix, rhs):
+    """Solve S x = b for symmetric positive definite S (small, dense); returns x (NaN if not SPD)."""
+    m = rhs.shape[0]
+    lower = np.zeros((m, m))
+    for i in range(m):
+        for j in range(i + 1):
+            acc = matrix[i, j]
+            for k in range(j):
+                acc -= lower[i, k] * lower[j, k]
+            if i == j:
+                if acc <= 0.0:
+                    return np.full(m, np.nan)
+                lower[i, i] = np.sqrt(acc)
+            else:
+                lower[i, j] = acc / lower[j, j]
+    x = rhs.copy()
+    for i in range(m):
+        for k in range(i):
+            x[i] -= lower[i, k] * x[k]
+        x[i] /= lower[i, i]
+    for i in range(m - 1, -1, -1):
+        for k in range(i + 1, m):
+            x[i] -= lower[k, i] * x[k]
+        x[i] /= lower[i, i]
+    return x
+
+
+@njit(cache=True)
+def constrained_response(jac, minv, force, gamma):
+    """(a, λ) with a = M⁻¹ (f − Φ_qᵀ λ) and Φ_q a = γ."""
+    weighted = jac * minv  # Φ_q M⁻¹ (column scaling)
+    lam = cholesky_solve(weighted @ jac.T, weighted @ force - gamma)
+    return minv * (force - jac.T @ lam), lam
+
+
+@njit(cache=True)
+def accelerations(system, t, q, qd, generalized):
+    """(q̈, λ) from M q̈ + Φ_qᵀ λ = Q, Φ_q q̈ = γ."""
+    n = q.shape[0]
+    m = constraint_count(system)
+    minv = inverse_mass(system)
+    if m == 0:
+        return minv * generalized, np.zeros(0)
+    jac = np.empty((m, n))
+    evaluate_jacobian(system, q, jac)
+    gamma = np.empty(m)
+    evaluate_acceleration_rhs(system, t, q, qd, gamma)
+    return constrained_response(jac, minv, generalized, gamma)
+
+
+@njit(cache=True)
+def driver_power(system, t, lam):
+    """Power of the driving constraints, −Σ λ_r ṡ_r(t) over rheonomic rows."""
+    power = 0.0
+    row = 2 * system.pin_bodies.shape[0]
+    for k in range(system.offset_bodies.shape[0]):
+        power -= lam[row] * prescribed(system, system.offset_law[k], t)[1]
+        row += 1
+    for k in range(system.angle_bodies.shape[0]):
+        power -= lam[row] * prescribed(system, system.angle_law[k], t)[1]
+        row += 1
+    return power
+
+
+@njit(cache=True)
+def generalized_forces(system, t, q, qd, modes, impact_speeds):
+    """(Q, applied power, damping loss, contact loss, friction loss)."""
+    generalized = np.zeros(q.shape[0])
+    applied, damping = add_applied_forces(system, t, q, qd, generalized)
+    contact, friction = add_clearance_forces(system, q, qd, modes, impact_speeds, generalized)
+    return generalized, applied, damping, contact, friction
+
+
+@njit(cache=True)
+def rhs(system, t, y, modes, impact_speeds, ydot):
+    """ẏ = f(t, y) for the current contact modes."""
+    n = coordinate_count(system)
+    q = y[:n]
+    qd = y[n:2 * n]
+    generalized, applied, damping, contact, friction = generalized_forces(system, t, q, qd, modes, impact_speeds)
+    qdd, lam = accelerations(system, t, q, qd, generalized)
+    ydot[:n] = qd
+    ydot[n:2 * n] = qdd
+    ydot[2 * n + WORK_DRIVER] = driver_power(system, t, lam)
+    ydot[2 * n + WORK_CONTACT] = contact
+    ydot[2 * n + WORK_FRICTION] = friction
+    ydot[2 * n + WORK_DAMPING] = damping
+    ydot[2 * n + WORK_APPLIED] = applied
+
+
+@njit(cache=True)
+def project_positions(system, t, q, tolerance, max_iterations):
+    """Newton projection of q onto Φ(q, t) = 0 in the M metric; returns the final max |Φ|."""
+    m = constraint_count(system)
+    if m == 0:
+        return 0.0
+    n = q.shape[0]
+    minv = inverse_mass(system)
+    phi = np.empty(m)
+    jac = np.empty((m, n))
+    for _ in range(max_iterations):
+        evaluate_constraints(system, t, q, phi)
+        if np.max(np.abs(phi)) <= tolerance:
+            break
+        evaluate_jacobian(system, q, jac)
+        weighted = jac * minv
+        correction = cholesky_solve(weighted @ jac.T, phi)
+        q -= minv * (jac.T @ correction)
+    evaluate_constraints(system, t, q, phi)
+    return np.max(np.abs(phi))
+
+
+@njit(cache=True)
+def project_velocities(system, t, q, qd):
+    """q̇ ← q̇ − M⁻¹Φ_qᵀ S⁻¹ (Φ_q q̇ − ν): the nearest consistent velocity in the M metric."""
+    m = constraint_count(system)
+    if m == 0:
+        return
+    n = q.shape[0]
+    jac = np.empty((m, n))
+    evaluate_jacobian(system, q, jac)
+    nu = np.empty(m)
+    evaluate_velocity_rhs(system, t, nu)
+    weighted = jac * inverse_mass(system)
+    correction = cholesky_solve(weighted @ jac.T, jac @ qd - nu)
+    qd -= inverse_mass(system) * (jac.T @ correction)
+
+
+@njit(cache=True)
+def constraint_violation(system, t, q):
+    """max |Φ(q, t)| (m or rad)."""
+    m = constraint_count(system)
+    if m == 0:
+        return 0.0
+    phi = np.empty(m)
+    evaluate_constraints(system, t, q, phi)
+    return np.max(np.abs(phi))
+
+
+@njit(cache=True)
+def effective_mass(system, k, q):
+    """m_eff of clearance joint k along n: 1/(wᵀ P w), P the constrained mobility, w the unit force pair."""
+    n = q.shape[0]
+    zero = np.zeros(n)
+    ex, ey, _, _, _, _, nx, ny, _ = clearance_kinematics(system, k, q, zero)
+    p = system.clearance_params[k]
+    bx, by = point_position(q, system.clearance_bodies[k, 0], p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+    pair = np.zeros(n)
+    add_global_force(pair, q, system.clearance_bodies[k, 1], bx + ex, by + ey, nx, ny)
+    add_global_force(pair, q, system.clearance_bodies[k, 0], bx, by, -nx, -ny)
+    minv = inverse_mass(system)
+    m = constraint_count(system)
+    if m == 0:
+        response = minv * pair
+    else:
+        jac = np.empty((m, n))
+        evaluate_jacobian(system, q, jac)
+        response = constrained_response(jac, minv, pair, np.zeros(m))[0]
+    mobility = pair @ response
+    return 1.0 / mobility if mobility > 0.0 else np.inf

@@ -1,0 +1,163 @@
+"""Generalised forces Q(t, q, q̇): gravity, point loads, spring-dampers and clearance contacts (compiled).
+
+Clearance joint k (Meng 2015 §2, restated in DESIGN.md §4): bearing centre P_B on the first body,
+journal centre P_J on the second; eccentricity e = P_J − P_B, n = e/|e|, penetration δ = |e| − c,
+penetration rate δ̇ = ė·n, tangent t = (−n_y, n_x) and sliding velocity
+v_t = ė·t + ω_J R_J − ω_B R_B (material points of journal and bearing at the contact).
+Forces act on the journal at P_J + R_J n:  −F_n n − μ(v_t) F_n t, and the opposite on the bearing
+at P_B + R_B n. Dissipated powers (F_n − K δⁿ) δ̇ and μ(v_t) F_n v_t are returned for the energy balance.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from clearsim.assembly.arrays import (
+    CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_POINT,
+    CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_RESTITUTION, CL_STIFFNESS,
+    CL_V_HIGH, CL_V_LOW,
+)
+from clearsim.assembly.kinematics import (
+    GROUND, add_point_force, body_pose, body_rates, point_position, point_velocity,
+)
+from clearsim.assembly.constraints import prescribed
+from clearsim.physics.contact import elastic_energy, elastic_force, normal_force
+from clearsim.physics.friction import friction_coefficient
+
+FREE = 0
+CONTACT = 1
+
+
+@njit(cache=True)
+def add_global_force(generalized, q, body, px, py, fx, fy):
+    """Add a global force (fx, fy) applied at the global point (px, py) of a body."""
+    if body == GROUND:
+        return
+    x, y, _ = body_pose(q, body)
+    generalized[3 * body] += fx
+    generalized[3 * body + 1] += fy
+    generalized[3 * body + 2] += (px - x) * fy - (py - y) * fx
+
+
+@njit(cache=True)
+def clearance_kinematics(system, k, q, qd):
+    """(e_x, e_y, ė_x, ė_y, δ, δ̇, n_x, n_y, v_t) of clearance joint k."""
+    p = system.clearance_params[k]
+    bearing = system.clearance_bodies[k, 0]
+    journal = system.clearance_bodies[k, 1]
+    bx, by = point_position(q, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+    jx, jy = point_position(q, journal, p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
+    bvx, bvy = point_velocity(q, qd, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+    jvx, jvy = point_velocity(q, qd, journal, p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
+    ex, ey = jx - bx, jy - by
+    dex, dey = jvx - bvx, jvy - bvy
+    eccentricity = np.sqrt(ex * ex + ey * ey)
+    nx, ny = 1.0, 0.0  # a centred journal has no contact direction; any unit vector will do
+    if eccentricity > 1e-300:
+        nx, ny = ex / eccentricity, ey / eccentricity
+    sliding = (-ny * dex + nx * dey + body_rates(qd, journal)[2] * p[CL_JOURNAL_RADIUS]
+               - body_rates(qd, bearing)[2] * p[CL_BEARING_RADIUS])
+    return ex, ey, dex, dey, eccentricity - p[CL_CLEARANCE], nx * dex + ny * dey, nx, ny, sliding
+
+
+@njit(cache=True)
+def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact_speed):
+    """(F_n, F_t, K δⁿ) of clearance joint k; zero in free flight. F_t is the signed force along t."""
+    if mode == FREE or penetration <= 0.0:
+        return 0.0, 0.0, 0.0
+    p = system.clearance_params[k]
+    guarded_speed = max(impact_speed, p[CL_MIN_IMPACT_SPEED])  # grazing guard, docs/model.md
+    force = normal_force(system.clearance_laws[k, 0], penetration, rate, guarded_speed,
+                         p[CL_STIFFNESS], p[CL_EXPONENT], p[CL_RESTITUTION])
+    mu = friction_coefficient(system.clearance_laws[k, 1], sliding, p[CL_MU_S], p[CL_MU_D],
+                              p[CL_V_LOW], p[CL_V_HIGH])
+    return force, -mu * force, elastic_force(penetration, p[CL_STIFFNESS], p[CL_EXPONENT])
+
+
+@njit(cache=True)
+def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized):
+    """Add all contact force pairs; return (contact dissipation power, friction dissipation power)."""
+    contact_loss = 0.0
+    friction_loss = 0.0
+    for k in range(system.clearance_bodies.shape[0]):
+        ex, ey, dex, dey, penetration, rate, nx, ny, sliding = clearance_kinematics(system, k, q, qd)
+        fn, ft, elastic = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], impact_speeds[k])
+        if fn == 0.0:
+            continue
+        p = system.clearance_params[k]
+        fx = -fn * nx - ft * ny
+        fy = -fn * ny + ft * nx
+        bearing = system.clearance_bodies[k, 0]
+        journal = system.clearance_bodies[k, 1]
+        bx, by = point_position(q, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+        add_global_force(generalized, q, journal, bx + ex + p[CL_JOURNAL_RADIUS] * nx,
+                         by + ey + p[CL_JOURNAL_RADIUS] * ny, fx, fy)
+        add_global_force(generalized, q, bearing, bx + p[CL_BEARING_RADIUS] * nx,
+                         by + p[CL_BEARING_RADIUS] * ny, -fx, -fy)
+        contact_loss += (fn - elastic) * rate
+        friction_loss -= ft * sliding
+    return contact_loss, friction_loss
+
+
+@njit(cache=True)
+def add_applied_forces(system, t, q, qd, generalized):
+    """Add gravity, point loads and spring-dampers; return (applied power, spring damping loss)."""
+    for b in range(system.mass.shape[0]):
+        generalized[3 * b] += system.mass[b] * system.gravity[0]
+        generalized[3 * b + 1] += system.mass[b] * system.gravity[1]
+    applied_power = 0.0
+    for k in range(system.load_bodies.shape[0]):
+        body = system.load_bodies[k]
+        p = system.load_params[k]
+        scale = 1.0 if system.load_law[k] < 0 else prescribed(system, system.load_law[k], t)[0]
+        fx, fy, torque = scale * p[2], scale * p[3], scale * p[4]
+        add_point_force(generalized, q, body, p[0], p[1], fx, fy)
+        if body != GROUND:
+            generalized[3 * body + 2] += torque
+        vx, vy = point_velocity(q, qd, body, p[0], p[1])
+        applied_power += fx * vx + fy * vy + torque * body_rates(qd, body)[2]
+    damping_loss = 0.0
+    for k in range(system.spring_bodies.shape[0]):
+        tension, rate, ux, uy = spring_state(system, k, q, qd)
+        p = system.spring_params[k]
+        bi, bj = system.spring_bodies[k, 0], system.spring_bodies[k, 1]
+        add_point_force(generalized, q, bi, p[0], p[1], tension * ux, tension * uy)
+        add_point_force(generalized, q, bj, p[2], p[3], -tension * ux, -tension * uy)
+        damping_loss += p[5] * rate * rate
+    return applied_power, damping_loss
+
+
+@njit(cache=True)
+def spring_state(system, k, q, qd):
+    """(tension f = k(ℓ − ℓ0) + c ℓ̇ + preload, ℓ̇, u_x, u_y) of spring-damper k, u from point i to j."""
+    p = system.spring_params[k]
+    bi, bj = system.spring_bodies[k, 0], system.spring_bodies[k, 1]
+    xi, yi = point_position(q, bi, p[0], p[1])
+    xj, yj = point_position(q, bj, p[2], p[3])
+    vix, viy = point_velocity(q, qd, bi, p[0], p[1])
+    vjx, vjy = point_velocity(q, qd, bj, p[2], p[3])
+    length = max(np.sqrt((xj - xi) ** 2 + (yj - yi) ** 2), 1e-300)
+    ux, uy = (xj - xi) / length, (yj - yi) / length
+    rate = ux * (vjx - vix) + uy * (vjy - viy)
+    return p[4] * (length - p[6]) + p[5] * rate + p[7], rate, ux, uy
+
+
+@njit(cache=True)
+def potential_energy(system, q):
+    """Gravity + spring (elastic and preload) + contact elastic energy K δⁿ⁺¹/(n+1)."""
+    energy = 0.0
+    for b in range(system.mass.shape[0]):
+        energy -= system.mass[b] * (system.gravity[0] * q[3 * b] + system.gravity[1] * q[3 * b + 1])
+    zero = np.zeros_like(q)
+    for k in range(system.spring_bodies.shape[0]):
+        p = system.spring_params[k]
+        xi, yi = point_position(q, system.spring_bodies[k, 0], p[0], p[1])
+        xj, yj = point_position(q, system.spring_bodies[k, 1], p[2], p[3])
+        length = np.sqrt((xj - xi) ** 2 + (yj - yi) ** 2)
+        energy += 0.5 * p[4] * (length - p[6]) ** 2 + p[7] * length
+    for k in range(system.clearance_bodies.shape[0]):
+        penetration = clearance_kinematics(system, k, q, zero)[4]
+        p = system.clearance_params[k]
+        energy += elastic_energy(penetration, p[CL_STIFFNESS], p[CL_EXPONENT])
+    return energy

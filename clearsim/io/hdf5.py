@@ -1,0 +1,117 @@
+"""Result files in the HDF5 layout of DESIGN.md §6, written as the run goes.
+
+The file is created with `complete = False` and `status = "running"`, every chunk of samples
+is appended and flushed, and `finish()` records the final status. A run that is interrupted
+or fails therefore leaves a readable file that says it is incomplete and why. An existing
+file is never overwritten: it is first renamed to the next free `<stem>.<k>.h5`.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from clearsim import __version__
+
+
+def keep_existing(path: Path) -> Path | None:
+    """Rename an existing result to <stem>.<k><suffix> (first free k); return the new name."""
+    path = Path(path)
+    if not path.exists():
+        return None
+    k = 1
+    while (backup := path.with_name(f"{path.stem}.{k}{path.suffix}")).exists():
+        k += 1
+    path.rename(backup)
+    return backup
+
+
+class ResultWriter:
+    """Append-only writer of one run's result file."""
+
+    def __init__(self, path: Path, config_yaml: str, attributes: dict | None = None):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.file = h5py.File(self.path, "w")
+        root = self.file.attrs
+        root["clearsim_version"] = __version__
+        root["created"] = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
+        root["config_yaml"] = config_yaml
+        root["complete"] = False
+        root["status"] = "running"
+        for key, value in (attributes or {}).items():
+            root[key] = value
+        self.rows = 0
+
+    def _append(self, name: str, values: np.ndarray, unit: str) -> None:
+        values = np.asarray(values)
+        if name not in self.file:
+            chunk_rows = max(1, min(4096, 2**20 // max(1, values[0].nbytes if values.ndim > 1 else 8)))
+            self.file.create_dataset(name, data=values, maxshape=(None, *values.shape[1:]),
+                                     chunks=(chunk_rows, *values.shape[1:]))
+            self.file[name].attrs["unit"] = unit
+            return
+        dataset = self.file[name]
+        start = dataset.shape[0]
+        dataset.resize(start + values.shape[0], axis=0)
+        dataset[start:] = values
+
+    def append(self, times: np.ndarray, datasets: dict) -> None:
+        """Add samples: /time and every `path → (values, unit)`; flushed to disk at once."""
+        self._append("time", times, "s")
+        for name, (values, unit) in datasets.items():
+            self._append(name, values, unit)
+        self.rows += len(times)
+        self.file.flush()
+
+    def replace(self, name: str, values: np.ndarray) -> None:
+        """Overwrite a whole dataset that was written chunk by chunk (e.g. contact modes once episodes end)."""
+        if name in self.file:
+            self.file[name][...] = values
+
+    def write_table(self, name: str, columns: dict, attributes: dict | None = None) -> None:
+        group = self.file.require_group(name)
+        for key, (values, unit) in columns.items():
+            if key in group:
+                del group[key]
+            group.create_dataset(key, data=np.asarray(values))
+            group[key].attrs["unit"] = unit
+        for key, value in (attributes or {}).items():
+            group.attrs[key] = value
+
+    def finish(self, complete: bool, status: str, attributes: dict) -> None:
+        root = self.file.attrs
+        root["complete"] = bool(complete)
+        root["status"] = status
+        for key, value in attributes.items():
+            root[key] = value
+        self.file.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        if self.file.id.valid:
+            self.file.close()
+
+
+class NotAResultFile(ValueError):
+    pass
+
+
+def read_result(path: Path) -> dict:
+    """All datasets (as arrays) and root attributes of a result file: {'attrs': {...}, 'time': …, 'bodies/x/q': …}."""
+    path = Path(path)
+    try:
+        handle = h5py.File(path, "r")
+    except OSError as exc:
+        raise NotAResultFile(f"{path} is not a readable HDF5 file ({exc})") from None
+    with handle:
+        if "clearsim_version" not in handle.attrs:
+            raise NotAResultFile(f"{path} is not a clearsim result file (no clearsim_version attribute)")
+        out = {"attrs": dict(handle.attrs)}
+        handle.visititems(lambda name, node: out.__setitem__(name, node[()]) if isinstance(node, h5py.Dataset) else None)
+        return out

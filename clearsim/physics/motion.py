@@ -1,0 +1,91 @@
+"""Prescribed motions and tabulated loads as piecewise polynomials.
+
+Every time law clearsim knows (the stroke law of Meng 2015 eq. 16, constant
+speed, a polynomial, a CSV table) becomes one `PiecewisePolynomial`: breakpoints
+b_0 < b_1 < … and, on [b_p, b_p+1), s(t) = Σ_k c_pk (t − b_p)^k. The last piece
+extends to +∞ and the first one to −∞, so a compiled kernel evaluates any law,
+with its first two derivatives, by one routine.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+MAX_COEFFICIENTS = 8  # degree 7: enough for a polynomial law and for a cubic spline
+
+
+@dataclass(frozen=True)
+class PiecewisePolynomial:
+    breaks: np.ndarray  # (pieces,) start of each piece, increasing
+    coefficients: np.ndarray  # (pieces, MAX_COEFFICIENTS), lowest power first
+
+    def __call__(self, t, derivative: int = 0):
+        return np.array([evaluate_piecewise(self.breaks, self.coefficients, 0, len(self.breaks), ti)[derivative]
+                         for ti in np.atleast_1d(t)])
+
+
+def _pad(coefficients) -> np.ndarray:
+    row = np.zeros(MAX_COEFFICIENTS)
+    row[: len(coefficients)] = coefficients
+    return row
+
+
+def stroke_law(stroke: float, duration: float, start: float = 0.0) -> PiecewisePolynomial:
+    """s = S τ²(3 − 2τ), τ = (t − t0)/T on [t0, t0 + T], 0 before, S after (Meng 2015 eq. 16)."""
+    cubic = [0.0, 0.0, 3.0 * stroke / duration**2, -2.0 * stroke / duration**3]
+    return PiecewisePolynomial(
+        np.array([start - 1.0, start, start + duration]),
+        np.array([_pad([0.0]), _pad(cubic), _pad([stroke])]),
+    )
+
+
+def polynomial_law(coefficients_from_first_power) -> PiecewisePolynomial:
+    """s = Σ_{k≥1} c_k t^k (a constant speed v is the list [v])."""
+    if len(coefficients_from_first_power) >= MAX_COEFFICIENTS:
+        raise ValueError(f"a polynomial law takes at most {MAX_COEFFICIENTS - 1} coefficients")
+    return PiecewisePolynomial(np.array([0.0]), np.array([_pad([0.0, *coefficients_from_first_power])]))
+
+
+def table_law(times: np.ndarray, values: np.ndarray, relative: bool = True) -> PiecewisePolynomial:
+    """Cubic spline through (t_i, s_i), held constant after the last sample; relative: s(t_0) = 0."""
+    from scipy.interpolate import CubicSpline
+
+    values = np.asarray(values, dtype=float) - (values[0] if relative else 0.0)
+    spline = CubicSpline(np.asarray(times, dtype=float), values, bc_type="not-a-knot")
+    pieces = [_pad(spline.c[::-1, p]) for p in range(spline.c.shape[1])]
+    breaks = list(spline.x[:-1])
+    breaks.append(spline.x[-1])
+    pieces.append(_pad([values[-1]]))
+    return PiecewisePolynomial(np.array(breaks), np.array(pieces))
+
+
+@njit(cache=True)
+def evaluate_piecewise(breaks, coefficients, first, count, t):
+    """(s, ṡ, s̈) at t of the polynomial stored in rows first … first+count−1."""
+    piece = first
+    for p in range(first + 1, first + count):
+        if t >= breaks[p]:
+            piece = p
+    x = t - breaks[piece]
+    value = 0.0
+    rate = 0.0
+    curvature = 0.0
+    for k in range(MAX_COEFFICIENTS - 1, -1, -1):
+        c = coefficients[piece, k]
+        curvature = curvature * x + rate
+        rate = rate * x + value
+        value = value * x + c
+    return value, rate, 2.0 * curvature
+
+
+def concatenate(laws: list[PiecewisePolynomial]):
+    """Pack several laws into flat arrays for the kernels: breaks, coefficients, first row, row count."""
+    if not laws:
+        return np.zeros(1), np.zeros((1, MAX_COEFFICIENTS)), np.zeros(0, np.int64), np.zeros(0, np.int64)
+    counts = np.array([len(law.breaks) for law in laws], dtype=np.int64)
+    firsts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    return (np.concatenate([law.breaks for law in laws]), np.vstack([law.coefficients for law in laws]),
+            firsts, counts)

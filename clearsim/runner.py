@@ -1,0 +1,142 @@
+"""The public pipeline: load → assemble → simulate → write, and the run summary.
+
+    loaded = load_mechanism(path, overrides)      # validated spec
+    system = prepare(loaded)                      # arrays + consistent initial state
+    report = run_to_file(system, loaded, out)     # HDF5 file, written as the run goes
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from clearsim.assembly.build import BuildError
+from clearsim.assembly.system import System, assemble
+from clearsim.errors import InputError, SolverError
+from clearsim.io.hdf5 import ResultWriter, keep_existing, read_result
+from clearsim.model.loader import LoadedMechanism, load_mechanism
+from clearsim.solver.outputs import classify_episodes, chunk_outputs, sample_modes
+from clearsim.solver.simulate import Run
+
+BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
+DEFAULT_OUTPUT = Path("results") / "run.h5"
+
+
+def prepare(loaded: LoadedMechanism) -> System:
+    """Assemble a loaded mechanism; assembly problems are reported at their place in the file."""
+    try:
+        return assemble(loaded.mechanism, loaded.base_dir)
+    except BuildError as exc:
+        raise InputError(exc.problems, file=loaded.path, source=loaded.source) from None
+
+
+@dataclass
+class RunReport:
+    output: Path
+    backup: Path | None
+    complete: bool
+    status: str
+    statistics: object
+    error: Exception | None = None
+
+
+def _attributes(system: System, loaded: LoadedMechanism) -> dict:
+    return {"config_path": str(loaded.path), "mechanism": system.mechanism.name,
+            "degrees_of_freedom": system.degrees_of_freedom,
+            "clearance_joints": ",".join(system.clearance_joints)}
+
+
+def _final_attributes(run: Run) -> dict:
+    stats = run.statistics()
+    return {"wall_time_s": stats.wall_time, "steps": stats.steps, "rejected_steps": stats.rejected_steps,
+            "rhs_evaluations": stats.rhs_evaluations, "contact_events": stats.contact_events,
+            "max_step_violation": stats.max_violation, "simulated_time_s": run.time}
+
+
+def _write_episodes(writer: ResultWriter, system: System, run: Run, sample_episodes: np.ndarray) -> None:
+    """Episode tables per clearance joint and the final contact modes of every sample."""
+    log = run.episode_log()
+    kinds = classify_episodes(system, log)
+    modes = sample_modes(kinds, sample_episodes)
+    stats = run.statistics()
+    for k, name in enumerate(system.clearance_joints):
+        mine = log.joint == k
+        writer.replace(f"joints/{name}/mode", modes[:, k])
+        writer.write_table(f"joints/{name}/episodes", {
+            "onset": (log.onset[mine], "s"), "loss": (log.loss[mine], "s"),
+            "impact_speed": (log.impact_speed[mine], "m/s"),
+            "effective_mass": (log.effective_mass[mine], "kg"),
+            "kind": (kinds[mine], "1 impact, 2 continuous contact")},
+            {"peak_normal_force_N": float(stats.peak_normal_force[k])})
+
+
+def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
+                progress: Callable[[float], None] | None = None) -> RunReport:
+    """Simulate and write as it goes; interruption or failure still leaves a flagged, readable file."""
+    output = Path(output)
+    backup = keep_existing(output)
+    run = Run(system)
+    episodes, status, complete, error = [], "complete", True, None
+    with ResultWriter(output, loaded.resolved_yaml, _attributes(system, loaded)) as writer:
+        try:
+            initial_energy = None
+            for chunk in run.chunks():
+                if initial_energy is None:
+                    initial_energy = float(chunk.kinetic[0] + chunk.potential[0])
+                episodes.append(chunk.episodes)
+                provisional = sample_modes(classify_episodes(system, run.episode_log()), chunk.episodes)
+                writer.append(chunk.times, chunk_outputs(system, chunk, provisional, initial_energy))
+                if progress is not None:
+                    progress(run.time)
+        except SolverError as exc:
+            status, complete, error = f"failed: {exc}", False, exc
+        except KeyboardInterrupt as exc:
+            status, complete, error = f"interrupted at t = {run.time * 1e3:.3f} ms", False, exc
+        finally:
+            if episodes:
+                _write_episodes(writer, system, run, np.concatenate(episodes))
+            writer.finish(complete, status, _final_attributes(run))
+    return RunReport(output, backup, complete, status, run.statistics(), error)
+
+
+def simulate_config(config: Path | str | None = None, overrides=(), output: Path | str = DEFAULT_OUTPUT,
+                    progress: Callable[[float], None] | None = None) -> RunReport:
+    """load → assemble → run → file, the whole of `clearsim run`."""
+    loaded = load_mechanism(Path(config) if config else BUNDLED_CONFIG, overrides)
+    return run_to_file(prepare(loaded), loaded, Path(output), progress)
+
+
+@dataclass
+class Summary:
+    peak_velocity: tuple[str, float] | None
+    peak_acceleration: tuple[str, float] | None
+    peak_contact_force: dict[str, float]
+    contact_time_share: dict[str, tuple[float, float, float]]
+
+
+def summarize(path: Path) -> Summary:
+    """The figures `clearsim run` prints, read back from a result file."""
+    data = read_result(path)
+    output = _output_sensors(data["attrs"]["config_yaml"])
+    peak = {}
+    for role in ("velocity", "acceleration"):
+        name = output.get(role)
+        key = f"sensors/{name}"
+        peak[role] = (name, float(np.max(np.abs(data[key])))) if name and key in data and len(data[key]) else None
+    joints = [j for j in str(data["attrs"].get("clearance_joints", "")).split(",") if j]
+    forces = {j: float(np.max(data[f"joints/{j}/normal_force"], initial=0.0)) for j in joints}
+    shares = {}
+    for j in joints:
+        mode = data[f"joints/{j}/mode"]
+        shares[j] = tuple(float(np.mean(mode == m)) if len(mode) else 0.0 for m in (0, 1, 2))
+    return Summary(peak["velocity"], peak["acceleration"], forces, shares)
+
+
+def _output_sensors(config_yaml: str) -> dict:
+    import yaml
+
+    document = yaml.safe_load(config_yaml) or {}
+    return dict(document.get("output") or {})

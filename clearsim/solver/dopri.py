@@ -1,0 +1,81 @@
+"""Dormand–Prince 5(4) with its 4th-order continuous extension (compiled).
+
+Coefficients as in Hairer, Nørsett & Wanner, Solving ODEs I, §II.5 and scipy's RK45 (the
+dense-output matrix P gives y(t + θh) = y + h Σ_j K_j Σ_p P_jp θ^(p+1)).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from clearsim.assembly.dynamics import rhs
+
+STAGES = 7
+NODES = np.array([0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0])
+MATRIX = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0],
+    [1 / 5, 0.0, 0.0, 0.0, 0.0],
+    [3 / 40, 9 / 40, 0.0, 0.0, 0.0],
+    [44 / 45, -56 / 15, 32 / 9, 0.0, 0.0],
+    [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0.0],
+    [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656],
+])
+WEIGHTS = np.array([35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84])
+ERROR_WEIGHTS = np.array([-71 / 57600, 0.0, 71 / 16695, -71 / 1920, 17253 / 339200, -22 / 525, 1 / 40])
+DENSE = np.array([
+    [1.0, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432],
+    [0.0, 0.0, 0.0, 0.0],
+    [0.0, 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799],
+    [0.0, -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072],
+    [0.0, 127303824393 / 49829197408, -318862633887 / 49829197408, 701980252875 / 199316789632],
+    [0.0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844],
+    [0.0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423],
+])
+
+
+@njit(cache=True)
+def step(system, t, y, f, h, modes, speeds, stages, y_new):
+    """One DOPRI5 step from (t, y) with ẏ(t) = f; fills stages (7, ny) and y_new; returns the error vector."""
+    stages[0, :] = f
+    work = np.empty_like(y)
+    for s in range(1, 6):
+        work[:] = y
+        for j in range(s):
+            if MATRIX[s, j] != 0.0:
+                work += h * MATRIX[s, j] * stages[j]
+        rhs(system, t + NODES[s] * h, work, modes, speeds, stages[s])
+    y_new[:] = y
+    for j in range(6):
+        if WEIGHTS[j] != 0.0:
+            y_new += h * WEIGHTS[j] * stages[j]
+    rhs(system, t + h, y_new, modes, speeds, stages[6])
+    error = np.zeros_like(y)
+    for j in range(STAGES):
+        if ERROR_WEIGHTS[j] != 0.0:
+            error += h * ERROR_WEIGHTS[j] * stages[j]
+    return error
+
+
+@njit(cache=True)
+def error_norm(error, y, y_new, count, rtol, atol):
+    """RMS of error/(atol + rtol max(|y|, |y_new|)) over the first `count` components."""
+    total = 0.0
+    for i in range(count):
+        scale = atol + rtol * max(abs(y[i]), abs(y_new[i]))
+        total += (error[i] / scale) ** 2
+    return np.sqrt(total / count)
+
+
+@njit(cache=True)
+def interpolate(y, stages, h, theta, out):
+    """Continuous extension y(t + θh) into out."""
+    out[:] = y
+    for j in range(STAGES):
+        weight = 0.0
+        power = theta
+        for p in range(4):
+            weight += DENSE[j, p] * power
+            power *= theta
+        if weight != 0.0:
+            out += h * weight * stages[j]

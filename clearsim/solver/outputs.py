@@ -1,0 +1,179 @@
+"""Named time histories from sampled chunks: the HDF5 layout of DESIGN.md §6 as a dict path → (array, unit).
+
+Contact modes (written per sample, int8): 0 free flight (no contact episode), 1 impact, 2
+continuous contact. A contact episode runs from onset (δ rising through 0) to loss; it is an
+*impact* when it ends within IMPACT_DURATION_FACTOR × the Hertz contact time of an impact at
+its own δ̇⁻ and effective mass (t_H = 2.943 δ_max/δ̇⁻, δ_max = (5 m_eff δ̇⁻²/(4K))^(2/5)),
+and *continuous contact* otherwise (including an episode still open at the end of the run).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from clearsim.assembly.arrays import CL_EXPONENT, CL_MIN_IMPACT_SPEED, CL_STIFFNESS, OFF_DIRECTION
+from clearsim.assembly.dynamics import WORK_APPLIED, WORK_CONTACT, WORK_DAMPING, WORK_DRIVER, WORK_FRICTION
+from clearsim.assembly.system import SensorSpec, System
+from clearsim.solver.samples import C_ECC_X, C_ECC_Y, C_FRICTION, C_NORMAL, C_PENETRATION, C_RATE, C_SLIDING
+
+FREE_FLIGHT, IMPACT, CONTINUOUS_CONTACT = 0, 1, 2
+IMPACT_DURATION_FACTOR = 3.0
+HERTZ_DURATION = 2.943  # t_c = 2.943 δ_max / v (docs/model-contact.md)
+
+COORDINATE_UNITS = {"q": "m, m, rad", "qd": "m/s, m/s, rad/s", "qdd": "m/s^2, m/s^2, rad/s^2"}
+
+
+def _rotate(angle, vectors):
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([c * vectors[..., 0] - s * vectors[..., 1], s * vectors[..., 0] + c * vectors[..., 1]], axis=-1)
+
+
+def classify_episodes(system: System, episodes) -> np.ndarray:
+    """IMPACT or CONTINUOUS_CONTACT for each logged contact episode."""
+    params = system.arrays.clearance_params[episodes.joint]
+    speed = np.maximum(episodes.impact_speed, params[:, CL_MIN_IMPACT_SPEED])
+    exponent = params[:, CL_EXPONENT]
+    depth = (5.0 * episodes.effective_mass * speed**2 / (4.0 * params[:, CL_STIFFNESS])) ** (1.0 / (exponent + 1.0))
+    hertz_time = HERTZ_DURATION * depth / speed
+    duration = episodes.loss - episodes.onset
+    short = np.isfinite(duration) & (duration <= IMPACT_DURATION_FACTOR * hertz_time)
+    return np.where(short, IMPACT, CONTINUOUS_CONTACT).astype(np.int8)
+
+
+def sample_modes(episode_kinds: np.ndarray, sample_episodes: np.ndarray) -> np.ndarray:
+    """(S, nc) int8 mode per sample from the episode each sample belongs to."""
+    modes = np.zeros(sample_episodes.shape, np.int8)
+    inside = sample_episodes >= 0
+    modes[inside] = episode_kinds[sample_episodes[inside]]
+    return modes
+
+
+def body_histories(system: System, chunk) -> dict:
+    n = system.coordinate_count
+    out = {}
+    for b, name in enumerate(system.body_names):
+        columns = slice(3 * b, 3 * b + 3)
+        out[f"bodies/{name}/q"] = (chunk.states[:, :n][:, columns], COORDINATE_UNITS["q"])
+        out[f"bodies/{name}/qd"] = (chunk.states[:, n:2 * n][:, columns], COORDINATE_UNITS["qd"])
+        out[f"bodies/{name}/qdd"] = (chunk.accelerations[:, columns], COORDINATE_UNITS["qdd"])
+    return out
+
+
+def ideal_joint_reactions(system: System, chunk) -> dict:
+    """Force on the second body of each ideal joint (global frame), from λ; driver efforts."""
+    out = {}
+    for k, name in enumerate(system.pin_joints):
+        out[f"joints/{name}/reaction"] = (chunk.multipliers[:, 2 * k:2 * k + 2], "N")
+    n_pin_rows = 2 * len(system.pin_joints)
+    arrays = system.arrays
+    for name, offset in system.prismatic_joints:
+        guide = arrays.offset_bodies[offset, 0]
+        angle = chunk.states[:, 3 * guide + 2] if guide >= 0 else np.zeros(len(chunk.times))
+        normal = _rotate(angle, arrays.offset_params[offset, OFF_DIRECTION:OFF_DIRECTION + 2][None, :])
+        out[f"joints/{name}/reaction"] = (-normal * chunk.multipliers[:, n_pin_rows + offset][:, None], "N")
+    for name, row in system.drivers:
+        out[f"drivers/{name}/effort"] = (-chunk.multipliers[:, row], "N or N*m")
+    return out
+
+
+def clearance_histories(system: System, chunk, modes: np.ndarray) -> dict:
+    out = {}
+    for k, name in enumerate(system.clearance_joints):
+        contact = chunk.contact[:, k, :]
+        out[f"joints/{name}/eccentricity"] = (contact[:, [C_ECC_X, C_ECC_Y]], "m")
+        out[f"joints/{name}/penetration"] = (contact[:, C_PENETRATION], "m")
+        out[f"joints/{name}/penetration_rate"] = (contact[:, C_RATE], "m/s")
+        out[f"joints/{name}/normal_force"] = (contact[:, C_NORMAL], "N")
+        out[f"joints/{name}/friction_force"] = (contact[:, C_FRICTION], "N")
+        out[f"joints/{name}/sliding_velocity"] = (contact[:, C_SLIDING], "m/s")
+        out[f"joints/{name}/mode"] = (modes[:, k], "0 free, 1 impact, 2 contact")
+    return out
+
+
+def energy_histories(system: System, chunk, initial_energy: float) -> dict:
+    n = system.coordinate_count
+    work = chunk.states[:, 2 * n:]
+    named = {
+        "kinetic": chunk.kinetic, "potential": chunk.potential,
+        "contact_dissipated": work[:, WORK_CONTACT], "friction_dissipated": work[:, WORK_FRICTION],
+        "damping_dissipated": work[:, WORK_DAMPING], "driver_work": work[:, WORK_DRIVER],
+        "applied_work": work[:, WORK_APPLIED],
+    }
+    named["balance_error"] = (chunk.kinetic + chunk.potential - initial_energy - work[:, WORK_DRIVER]
+                              - work[:, WORK_APPLIED] + work[:, WORK_CONTACT] + work[:, WORK_FRICTION]
+                              + work[:, WORK_DAMPING])
+    return {f"energy/{key}": (value, "J") for key, value in named.items()}
+
+
+def _point_kinematics(spec: SensorSpec, n: int, chunk):
+    """Global position, velocity and acceleration of a sensor's body point."""
+    b = spec.body
+    q, qd, qdd = chunk.states[:, 3 * b:3 * b + 3], chunk.states[:, n + 3 * b:n + 3 * b + 3], chunk.accelerations[:, 3 * b:3 * b + 3]
+    arm = _rotate(q[:, 2], np.asarray(spec.point)[None, :])
+    turned = np.stack([-arm[:, 1], arm[:, 0]], axis=1)
+    position = q[:, :2] + arm
+    velocity = qd[:, :2] + qd[:, 2:3] * turned
+    acceleration = qdd[:, :2] + qdd[:, 2:3] * turned - qd[:, 2:3] ** 2 * arm
+    return position, velocity, acceleration
+
+
+SENSOR_UNITS = {"point_displacement": "m", "point_velocity": "m/s", "point_acceleration": "m/s^2",
+                "body_angle": "rad", "body_angular_velocity": "rad/s", "body_angular_acceleration": "rad/s^2"}
+
+
+def sensor_value(system: System, spec: SensorSpec, chunk, joint_outputs: dict, origin: np.ndarray) -> tuple:
+    """(values, unit) of one sensor over the chunk; `origin` is the point's position at t = 0."""
+    n = system.coordinate_count
+    if spec.kind.startswith("point_"):
+        position, velocity, acceleration = _point_kinematics(spec, n, chunk)
+        vector = {"point_displacement": position - origin, "point_velocity": velocity,
+                  "point_acceleration": acceleration}[spec.kind]
+        return vector @ np.asarray(spec.direction), SENSOR_UNITS[spec.kind]
+    if spec.kind.startswith("body_"):
+        column = {"body_angle": chunk.states[:, 3 * spec.body + 2],
+                  "body_angular_velocity": chunk.states[:, n + 3 * spec.body + 2],
+                  "body_angular_acceleration": chunk.accelerations[:, 3 * spec.body + 2]}[spec.kind]
+        return column, SENSOR_UNITS[spec.kind]
+    return joint_force_component(spec, joint_outputs), "N"
+
+
+def joint_force_component(spec: SensorSpec, joint_outputs: dict) -> np.ndarray:
+    prefix = f"joints/{spec.joint}/"
+    if spec.component in ("normal", "friction"):
+        return joint_outputs[prefix + f"{spec.component}_force"][0]
+    if prefix + "reaction" in joint_outputs:
+        force = joint_outputs[prefix + "reaction"][0]
+    else:  # clearance joint: the contact force on the journal in global components
+        ecc = joint_outputs[prefix + "eccentricity"][0]
+        normal = ecc / np.maximum(np.linalg.norm(ecc, axis=1, keepdims=True), 1e-300)
+        tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
+        force = (-joint_outputs[prefix + "normal_force"][0][:, None] * normal
+                 + joint_outputs[prefix + "friction_force"][0][:, None] * tangent)
+    if spec.component == "x":
+        return force[:, 0]
+    if spec.component == "y":
+        return force[:, 1]
+    return np.linalg.norm(force, axis=1)
+
+
+def sensor_origins(system: System) -> dict[str, np.ndarray]:
+    """Each point sensor's global position at t = 0 (displacements are measured from it)."""
+    origins = {}
+    for spec in system.sensors:
+        if spec.kind.startswith("point_"):
+            q = system.q0[3 * spec.body:3 * spec.body + 3]
+            origins[spec.name] = q[:2] + _rotate(np.array([q[2]]), np.asarray(spec.point)[None, :])[0]
+    return origins
+
+
+def chunk_outputs(system: System, chunk, modes: np.ndarray, initial_energy: float) -> dict:
+    """Every dataset of the result file for one chunk (except /time)."""
+    out = body_histories(system, chunk)
+    joints = ideal_joint_reactions(system, chunk) | clearance_histories(system, chunk, modes)
+    out |= joints
+    out |= energy_histories(system, chunk, initial_energy)
+    out["constraints/violation"] = (chunk.violation, "m")
+    origins = sensor_origins(system)
+    for spec in system.sensors:
+        out[f"sensors/{spec.name}"] = sensor_value(system, spec, chunk, joints, origins.get(spec.name))
+    return out

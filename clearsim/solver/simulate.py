@@ -1,0 +1,225 @@
+"""simulate(system) → time histories by name: the Python side of the compiled integration loop.
+
+`Run.chunks()` yields blocks of output samples as the compiled loop produces them, so that
+the caller can show progress, write them to disk and survive Ctrl-C; `simulate()` collects
+them into one `History`. A solver failure stops the run with a `SolverError` naming the time
+and the joint involved, after every sample up to that point has been yielded.
+"""
+
+from __future__ import annotations
+
+import time as clock
+from dataclasses import dataclass, field
+from typing import Callable, Iterator
+
+import numpy as np
+
+from clearsim.assembly.arrays import CL_CLEARANCE
+from clearsim.assembly.constraints import constraint_count, evaluate_constraints
+from clearsim.assembly.dynamics import WORK_COUNT, rhs
+from clearsim.assembly.forces import FREE
+from clearsim.assembly.system import System
+from clearsim.errors import SolverError
+from clearsim.solver import integrator as ig
+from clearsim.solver.samples import evaluate_samples
+
+SAMPLE_BUFFER = 2048
+LOG_CAPACITY = 4096
+CHUNKS = 100  # progress granularity: the loop returns to Python every 1 % of t_end
+
+
+@dataclass
+class Chunk:
+    """Output samples of one stretch of the run, with everything derived from them."""
+
+    times: np.ndarray
+    states: np.ndarray  # (S, 2n + WORK_COUNT): q, q̇, integrated powers
+    modes: np.ndarray  # (S, nc) FREE / CONTACT while the sample's step ran
+    impact_speeds: np.ndarray  # (S, nc) δ̇⁻ of the current contact episode
+    episodes: np.ndarray  # (S, nc) index into the episode log, −1 in free flight
+    accelerations: np.ndarray  # (S, n)
+    multipliers: np.ndarray  # (S, m)
+    contact: np.ndarray  # (S, nc, CONTACT_FIELDS)
+    kinetic: np.ndarray
+    potential: np.ndarray
+    violation: np.ndarray
+
+
+@dataclass
+class Statistics:
+    steps: int = 0
+    rejected_steps: int = 0
+    rhs_evaluations: int = 0
+    contact_events: int = 0
+    max_violation: float = 0.0
+    wall_time: float = 0.0
+    peak_normal_force: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+
+@dataclass
+class EpisodeLog:
+    """One row per contact episode: joint index, onset and loss time, impact speed δ̇⁻, effective mass."""
+
+    joint: np.ndarray
+    onset: np.ndarray
+    loss: np.ndarray
+    impact_speed: np.ndarray
+    effective_mass: np.ndarray
+
+
+def _initial_step(system: System, y: np.ndarray, f: np.ndarray) -> float:
+    """0.01 ‖y‖/‖ẏ‖ in the tolerance-weighted norm (Hairer, Nørsett & Wanner II.4), within the limits."""
+    settings = system.mechanism.solver
+    if settings.initial_step is not None:
+        return settings.initial_step
+    n = system.coordinate_count
+    scale = settings.atol + settings.rtol * np.abs(y[: 2 * n])
+    d0 = np.sqrt(np.mean((y[: 2 * n] / scale) ** 2))
+    d1 = np.sqrt(np.mean((f[: 2 * n] / scale) ** 2))
+    guess = 0.01 * d0 / d1 if d0 > 1e-5 and d1 > 1e-5 else 1e-6
+    return float(np.clip(guess, settings.min_step, settings.max_step))
+
+
+class Run:
+    """The integrator's state arrays for one simulation of a System."""
+
+    def __init__(self, system: System):
+        self.system = system
+        settings = system.mechanism.solver
+        arrays = system.arrays
+        nc = len(system.clearance_joints)
+        n = system.coordinate_count
+        self.y = np.concatenate([system.q0, system.qd0, np.zeros(WORK_COUNT)])
+        self.f = np.zeros_like(self.y)
+        self.modes = np.zeros(nc, np.int64)
+        self.speeds = np.zeros(nc)
+        self.episode_of = np.full(nc, -1, np.int64)
+        self.log = [np.zeros(LOG_CAPACITY, np.int64)] + [np.zeros(LOG_CAPACITY) for _ in range(4)]
+        self.peak_force = np.zeros(nc)
+        self.real = np.zeros(9)
+        self.ints = np.zeros(10, np.int64)
+        dt = 1.0 / settings.output_rate
+        self.real[[ig.R_T_END, ig.R_RTOL, ig.R_ATOL, ig.R_MAX_STEP, ig.R_MIN_STEP, ig.R_SAMPLE_DT]] = (
+            settings.t_end, settings.rtol, settings.atol, settings.max_step, settings.min_step, dt)
+        self.ints[ig.I_TOTAL_SAMPLES] = int(np.floor(settings.t_end / dt + 1e-9)) + 1
+        self.buffers = (np.zeros(SAMPLE_BUFFER), np.zeros((SAMPLE_BUFFER, self.y.size)),
+                        np.zeros((SAMPLE_BUFFER, nc), np.int64), np.zeros((SAMPLE_BUFFER, nc)),
+                        np.zeros((SAMPLE_BUFFER, nc), np.int64))
+        rhs(arrays, 0.0, self.y, self.modes, self.speeds, self.f)
+        self.real[ig.R_STEP] = _initial_step(system, self.y, self.f)
+        self.wall_time = 0.0
+        self.coordinate_count = n
+
+    @property
+    def time(self) -> float:
+        return float(self.real[ig.R_TIME])
+
+    def statistics(self) -> Statistics:
+        return Statistics(
+            steps=int(self.ints[ig.I_STEPS]), rejected_steps=int(self.ints[ig.I_REJECTED]),
+            rhs_evaluations=int(self.ints[ig.I_RHS]), contact_events=int(self.ints[ig.I_EVENTS]),
+            max_violation=float(self.real[ig.R_VIOLATION]), wall_time=self.wall_time,
+            peak_normal_force=self.peak_force.copy(),
+        )
+
+    def episode_log(self) -> EpisodeLog:
+        count = int(self.ints[ig.I_LOG])
+        joint, onset, loss, speed, mass = (a[:count].copy() for a in self.log)
+        return EpisodeLog(joint, onset, loss, speed, mass)
+
+    def _grow_log(self) -> None:
+        self.log = [np.concatenate([a, np.zeros_like(a)]) for a in self.log]
+
+    def _advance(self, t_stop: float) -> None:
+        started = clock.perf_counter()
+        ig.advance(self.system.arrays, self.y, self.f, self.real, self.ints, self.modes, self.speeds,
+                   self.episode_of, *self.log, self.peak_force, *self.buffers, t_stop)
+        self.wall_time += clock.perf_counter() - started
+
+    def _take_samples(self) -> Chunk | None:
+        count = int(self.ints[ig.I_SAMPLES])
+        if count == 0:
+            return None
+        times, states, modes, speeds, episodes = (b[:count].copy() for b in self.buffers)
+        self.ints[ig.I_SAMPLES] = 0
+        derived = evaluate_samples(self.system.arrays, times, states, modes, speeds)
+        return Chunk(times, states, modes, speeds, episodes, *derived)
+
+    def chunks(self) -> Iterator[Chunk]:
+        """Integrate to t_end, yielding samples as they come; SolverError on failure (after the samples)."""
+        t_end = self.real[ig.R_T_END]
+        next_stop = t_end / CHUNKS
+        while True:
+            self._advance(next_stop)
+            status = int(self.ints[ig.I_STATUS])
+            if status == ig.BUFFER_FULL and self.ints[ig.I_LOG] >= self.log[0].size - len(self.modes) - 1:
+                self._grow_log()
+            chunk = self._take_samples()
+            if chunk is not None:
+                yield chunk
+            if status == ig.DONE:
+                return
+            if status == ig.CHUNK_END:
+                next_stop = min(t_end, next_stop + t_end / CHUNKS)
+            elif status not in (ig.BUFFER_FULL,):
+                raise self._failure(status)
+
+    def _failure(self, status: int) -> SolverError:
+        """The failure in names: time, the joint involved, what to try."""
+        settings = self.system.mechanism.solver
+        t = self.time
+        joint = self._involved_joint(status)
+        messages = {
+            ig.MIN_STEP: (f"the step size fell below solver.min_step = {settings.min_step:.3g} s",
+                          "a contact stiffer than min_step can resolve, or a force that jumps: lower solver.min_step, "
+                          "check the contact stiffness and its units, or raise contact.min_impact_speed"),
+            ig.NOT_FINITE: ("the state became NaN or infinite",
+                            "check masses, inertias, stiffness and force units for values off by orders of magnitude"),
+            ig.DRIFT: ("the constraints could not be satisfied any more (assembly lost)",
+                       "the mechanism reaches a toggle or singular position here: check the geometry and the drive stroke"),
+            ig.TOO_DEEP: ("the journal penetrated deeper than the clearance",
+                          "the contact stiffness is far too low for the load: check `stiffness` and its unit (N/m^1.5)"),
+        }
+        message, hint = messages[status]
+        return SolverError(message, time=t, element=joint, hint=hint)
+
+    def _involved_joint(self, status: int) -> str | None:
+        system = self.system
+        if status == ig.DRIFT:
+            m = constraint_count(system.arrays)
+            phi = np.zeros(m)
+            evaluate_constraints(system.arrays, self.time, self.y[: self.coordinate_count], phi)
+            return f"joint {system.row_owners[int(np.argmax(np.abs(phi)))]}" if m else None
+        if status == ig.TOO_DEEP:
+            return f"joint {system.clearance_joints[int(self.ints[ig.I_FAIL_JOINT])]}"
+        in_contact = [k for k, mode in enumerate(self.modes) if mode != FREE]
+        if in_contact:
+            return f"joint {system.clearance_joints[in_contact[0]]} (in contact)"
+        return None
+
+
+@dataclass
+class History:
+    """A whole run's samples (the chunks joined), its episode log and statistics."""
+
+    system: System
+    chunk: Chunk
+    episodes: EpisodeLog
+    statistics: Statistics
+    complete: bool
+    status: str
+
+
+def join_chunks(chunks: list[Chunk]) -> Chunk:
+    return Chunk(*(np.concatenate([getattr(c, name) for c in chunks]) for name in Chunk.__dataclass_fields__))
+
+
+def simulate(system: System, progress: Callable[[float], None] | None = None) -> History:
+    """Run to t_end and return the History; SolverError propagates (use Run.chunks to keep partial results)."""
+    run = Run(system)
+    chunks = []
+    for chunk in run.chunks():
+        chunks.append(chunk)
+        if progress is not None:
+            progress(run.time)
+    return History(system, join_chunks(chunks), run.episode_log(), run.statistics(), True, "complete")

@@ -153,8 +153,9 @@ def _newton_assembly(arrays: SystemArrays, q: np.ndarray, owners: list[str]) -> 
                               "check the joint locations and link lengths: the loop through these joints does not close")])
 
 
-def _consistent_velocities(arrays: SystemArrays, q: np.ndarray, qd: np.ndarray, mass_diag: np.ndarray) -> np.ndarray:
-    """The velocity nearest to qd in the M metric with Φ_q q̇ = ν(0)."""
+def _consistent_velocities(arrays: SystemArrays, q: np.ndarray, qd: np.ndarray, mass_diag: np.ndarray,
+                           clearances: list, first_clearance_row: int) -> np.ndarray:
+    """The velocity nearest to qd in the M metric with Φ_q q̇ = ν(0), journals at their initial relative velocity."""
     m = constraint_count(arrays)
     if m == 0:
         return qd
@@ -162,6 +163,9 @@ def _consistent_velocities(arrays: SystemArrays, q: np.ndarray, qd: np.ndarray, 
     evaluate_jacobian(arrays, q, jac)
     nu = np.empty(m)
     evaluate_velocity_rhs(arrays, 0.0, nu)
+    for k, clearance in enumerate(clearances):  # pin rows P_B + e0 − P_J: d/dt = −ė0
+        row = first_clearance_row + 2 * k
+        nu[row:row + 2] = -np.asarray(clearance[4].initial_velocity, float)
     scale = 1.0 / np.sqrt(mass_diag)
     correction = np.linalg.lstsq(jac * scale, jac @ qd - nu, rcond=None)[0]
     return qd - scale * correction
@@ -226,7 +230,8 @@ def assemble(mechanism: schema.Mechanism, base_dir: Path | str = ".") -> System:
     q0 = _newton_assembly(assembly_arrays, _initial_coordinates(mechanism), assembly_owners)
     rank = _check_rank(arrays, q0, owners)
     mass_diag = np.column_stack([arrays.mass, arrays.mass, arrays.inertia]).ravel()
-    qd0 = _consistent_velocities(assembly_arrays, q0, _initial_velocities(mechanism), mass_diag)
+    qd0 = _consistent_velocities(assembly_arrays, q0, _initial_velocities(mechanism), mass_diag,
+                                 clearances, 2 * len(rows.pins))
     n_offsets = len(rows.offsets)
     return System(
         arrays=arrays,

@@ -132,6 +132,8 @@ class RevoluteJoint(Strict):
     contact: ContactSpec | None = None
     friction: FrictionSpec | None = None
     initial_eccentricity: Point | None = Field(None, description="journal centre - bearing centre at t = 0")
+    initial_velocity: tuple[Speed, Speed] | None = Field(
+        None, description="velocity of the journal centre relative to the bearing centre at t = 0 (default 0)")
 
 
 class PrismaticJoint(Strict):

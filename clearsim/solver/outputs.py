@@ -138,11 +138,16 @@ def sensor_value(system: System, spec: SensorSpec, chunk, joint_outputs: dict, o
 
 
 def joint_force_component(spec: SensorSpec, joint_outputs: dict) -> np.ndarray:
+    """A joint's force component; an ideal joint's 'normal' force is its reaction magnitude, its friction 0."""
     prefix = f"joints/{spec.joint}/"
-    if spec.component in ("normal", "friction"):
+    if spec.component in ("normal", "friction") and prefix + "normal_force" in joint_outputs:
         return joint_outputs[prefix + f"{spec.component}_force"][0]
     if prefix + "reaction" in joint_outputs:
         force = joint_outputs[prefix + "reaction"][0]
+        if spec.component == "friction":
+            return np.zeros(len(force))
+        if spec.component == "normal":
+            return np.linalg.norm(force, axis=1)
     else:  # clearance joint: the contact force on the journal in global components
         ecc = joint_outputs[prefix + "eccentricity"][0]
         normal = ecc / np.maximum(np.linalg.norm(ecc, axis=1, keepdims=True), 1e-300)

@@ -1,0 +1,29 @@
+"""Helpers for physics tests: run a config (bundled or inline YAML) and read its result file."""
+
+from pathlib import Path
+
+import pytest
+
+from clearsim.io.hdf5 import read_result
+from clearsim.model.loader import load_mechanism, load_mechanism_text
+from clearsim.runner import prepare, run_to_file
+
+CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
+
+
+@pytest.fixture
+def simulate(tmp_path):
+    """simulate(config_name_or_yaml_text, *overrides) → dict of the result file's datasets."""
+    counter = iter(range(10**6))
+
+    def run(source: str, *overrides: str) -> dict:
+        if source.endswith(".yaml") and "\n" not in source:
+            loaded = load_mechanism(CONFIGS / source, overrides)
+        else:
+            loaded = load_mechanism_text(source, overrides=overrides)
+        output = tmp_path / f"run{next(counter)}.h5"
+        report = run_to_file(prepare(loaded), loaded, output)
+        assert report.complete, report.status
+        return read_result(output)
+
+    return run

@@ -1,0 +1,88 @@
+"""The result file: DESIGN.md §6 layout, units, round trip of the config, flagged partial results, backups."""
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+
+from clearsim.io.hdf5 import read_result
+from clearsim.model.loader import load_mechanism, load_mechanism_text
+from clearsim.runner import prepare, run_to_file
+
+from .conftest import CONFIGS
+
+SHORT = ("solver.t_end=3ms",)
+
+
+def run(tmp_path, name="sc.h5", overrides=SHORT, progress=None):
+    loaded = load_mechanism(CONFIGS / "slider_crank_flores.yaml", overrides)
+    return run_to_file(prepare(loaded), loaded, tmp_path / name, progress), loaded
+
+
+def test_layout_units_and_attributes(tmp_path):
+    report, _ = run(tmp_path)
+    with h5py.File(report.output) as f:
+        for key in ("clearsim_version", "created", "config_yaml", "complete", "status", "wall_time_s", "steps",
+                    "rhs_evaluations"):
+            assert key in f.attrs, key
+        assert bool(f.attrs["complete"]) and f.attrs["status"] == "complete"
+        samples = f["time"].shape[0]
+        assert samples == 301 and f["time"].attrs["unit"] == "s"
+        for body in ("crank", "rod", "slider"):
+            for kind in ("q", "qd", "qdd"):
+                assert f[f"bodies/{body}/{kind}"].shape == (samples, 3)
+        for joint in ("crank_pivot", "crank_pin", "slider_guide"):
+            assert f[f"joints/{joint}/reaction"].shape == (samples, 2)
+        assert f["joints/slider_pin/eccentricity"].shape == (samples, 2)
+        for name in ("penetration", "normal_force", "friction_force", "mode"):
+            assert f[f"joints/slider_pin/{name}"].shape == (samples,)
+        assert f["joints/slider_pin/mode"].dtype == np.int8
+        for kind in ("kinetic", "potential", "contact_dissipated", "friction_dissipated", "driver_work"):
+            assert f[f"energy/{kind}"].shape == (samples,)
+        assert f["constraints/violation"].shape == (samples,)
+        assert f["sensors/slider_velocity"].shape == (samples,)
+        missing_units = []
+        f.visititems(lambda name, node: missing_units.append(name)
+                     if isinstance(node, h5py.Dataset) and "unit" not in node.attrs else None)
+        assert missing_units == []
+
+
+def test_config_text_reproduces_the_run(tmp_path):
+    report, loaded = run(tmp_path)
+    stored = read_result(report.output)["attrs"]["config_yaml"]
+    again = load_mechanism_text(stored)
+    assert again.mechanism == loaded.mechanism
+    assert yaml.safe_load(stored)["solver"]["t_end"] == "3ms"
+
+
+def test_interrupted_run_leaves_a_readable_flagged_file(tmp_path):
+    def interrupt(t):
+        if t > 1e-3:
+            raise KeyboardInterrupt
+
+    report, _ = run(tmp_path, progress=interrupt)
+    result = read_result(report.output)
+    assert not result["attrs"]["complete"]
+    assert result["attrs"]["status"].startswith("interrupted")
+    assert 0.001 <= result["time"][-1] < 0.003
+    assert result["bodies/rod/q"].shape[0] == result["time"].shape[0]
+
+
+def test_solver_failure_keeps_samples_and_names_time_and_joint(tmp_path):
+    report, _ = run(tmp_path, overrides=SHORT + ("solver.min_step=2e-5s",))
+    assert not report.complete
+    message = str(report.error)
+    assert "slider_pin" in message and "min_step" in message and "ms" in message
+    result = read_result(report.output)
+    assert result["attrs"]["status"].startswith("failed")
+    assert 0.0 < result["time"][-1] < 0.003  # everything up to the failure is there
+
+
+def test_an_existing_result_is_kept_as_a_numbered_backup(tmp_path):
+    first, _ = run(tmp_path)
+    created = read_result(first.output)["attrs"]["created"]
+    second, _ = run(tmp_path)
+    assert second.backup == tmp_path / "sc.1.h5"
+    assert read_result(second.backup)["attrs"]["created"] == created
+    third, _ = run(tmp_path)
+    assert third.backup == tmp_path / "sc.2.h5"

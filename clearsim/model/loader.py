@@ -1,0 +1,273 @@
+"""YAML file → validated Mechanism, with every problem of the file reported at once, located.
+
+    loaded = load_mechanism("configs/uhv_breaker.yaml", ["joints.J.clearance=0.1mm"])
+    loaded.mechanism            # schema.Mechanism, SI floats
+    loaded.resolved_yaml        # the YAML after overrides (written into result files)
+
+Stages: YAML syntax (with duplicate keys as errors) → `--set` overrides →
+schema validation → cross-references (clearsim.model.references). Problems of
+the first stage stop the load; the later ones are gathered into one InputError.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+import yaml
+from pydantic import ValidationError
+from yaml.constructor import SafeConstructor
+from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
+
+from clearsim.errors import InputError, Problem
+from clearsim.model.messages import validation_problems
+from clearsim.model.overrides import apply_overrides
+from clearsim.model.paths import locate_error
+from clearsim.model.references import KINDS, check_references
+from clearsim.model.schema import Mechanism
+
+MERGE_TAG = "tag:yaml.org,2002:merge"
+
+
+@dataclass
+class SourceMap:
+    """Where each YAML path is written: path → (line, column), 1-based; plus list items' names.
+
+    A mapping entry is located at its value when the value is a scalar or a flow
+    collection (`bodies: [a, b]`), at its key when the value is a block below it.
+    """
+
+    positions: dict[tuple, tuple[int, int]] = field(default_factory=dict)
+    names: dict[tuple, str] = field(default_factory=dict)
+    overrides: dict[tuple, str] = field(default_factory=dict)  # path set by --set → its text
+
+    @classmethod
+    def from_text(cls, text: str) -> "SourceMap":
+        return cls.from_node(yaml.compose(text, Loader=yaml.SafeLoader))
+
+    @classmethod
+    def from_node(cls, root: Node | None) -> "SourceMap":
+        source = cls()
+        if root is not None:
+            source.positions[()] = _position(root)
+            source._walk(root, (), set())
+        return source
+
+    def locate(self, path: tuple) -> tuple[tuple[int, int] | None, tuple]:
+        """(position, path found) of `path` or of its nearest ancestor written in the file."""
+        for depth in range(len(path), -1, -1):
+            position = self.positions.get(tuple(path[:depth]))
+            if position is not None:
+                return position, tuple(path[:depth])
+        return None, ()
+
+    def override_for(self, path: tuple) -> str | None:
+        """The `--set` text that wrote `path` or one of its ancestors."""
+        for depth in range(len(path), 0, -1):
+            text = self.overrides.get(tuple(path[:depth]))
+            if text is not None:
+                return text
+        return None
+
+    def _walk(self, node: Node, path: tuple, active: set) -> None:
+        if id(node) in active:  # a recursive alias
+            return
+        active = active | {id(node)}
+        if isinstance(node, SequenceNode):
+            for index, item in enumerate(node.value):
+                self._add(path + (index,), item)
+                self._walk(item, path + (index,), active)
+        elif isinstance(node, MappingNode):
+            merged = [value for key, value in node.value if key.tag == MERGE_TAG]
+            for key, value in node.value:
+                if key.tag != MERGE_TAG:
+                    child = path + (scalar_key(key),)
+                    self.positions.setdefault(child, _position(key if _is_block(value) else value))
+                    self._walk(value, child, active)
+            for value in merged:  # keys written explicitly win over merged ones
+                for mapping in value.value if isinstance(value, SequenceNode) else [value]:
+                    self._walk(mapping, path, active)
+
+    def _add(self, path: tuple, item: Node) -> None:
+        self.positions.setdefault(path, _position(item))
+        if isinstance(item, MappingNode):
+            for key, value in item.value:
+                if isinstance(key, ScalarNode) and key.value == "name" and isinstance(value, ScalarNode):
+                    self.names.setdefault(path, value.value)
+
+
+def _position(node: Node) -> tuple[int, int]:
+    return node.start_mark.line + 1, node.start_mark.column + 1
+
+
+def _is_block(node: Node) -> bool:
+    return isinstance(node, (MappingNode, SequenceNode)) and not node.flow_style
+
+
+def scalar_key(node: Node) -> Any:
+    """A mapping key as the YAML loader constructs it (`1:` is the integer 1)."""
+    if not isinstance(node, ScalarNode):
+        return str(node.value)
+    try:
+        key = SafeConstructor().construct_object(node)
+        hash(key)
+        return key
+    except Exception:
+        return node.value
+
+
+# --- YAML syntax ----------------------------------------------------------------------------------
+
+_SYNTAX_HINTS = {
+    "'\\t'": "indent with spaces: YAML does not allow tabs",
+    "mapping values are not allowed": "a value that contains ': ' must be quoted, or a key is indented wrongly",
+    "expected <block end>": "check the indentation of this line against the lines above",
+    "could not find expected ':'": "a key needs ': ' after it (or a text value needs quotes)",
+    "expected ',' or ']'": "a [list] is not closed, or an item needs quotes",
+    "expected ',' or '}'": "a {mapping} is not closed, or an item needs quotes",
+    "could not determine a constructor": "a mechanism file is plain YAML: remove the tag (!!...)",
+    "expected a single document": "a mechanism file holds one YAML document: remove the extra '---'",
+}
+
+
+def _syntax_problem(exc: yaml.YAMLError) -> Problem:
+    mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
+    text = " ".join(str(part) for part in (getattr(exc, "context", None), getattr(exc, "problem", None)) if part)
+    text = text or str(exc)
+    hint = next((h for key, h in _SYNTAX_HINTS.items() if key in text), "check the YAML syntax at this line")
+    position = (mark.line + 1, mark.column + 1) if mark is not None else None
+    return Problem((), f"invalid YAML: {text}", hint, position=position)
+
+
+def duplicate_keys(node: Node | None, path: tuple = ()) -> list[Problem]:
+    """Keys written twice in one mapping (YAML itself would silently keep the last)."""
+    problems: list[Problem] = []
+    if isinstance(node, SequenceNode):
+        for index, item in enumerate(node.value):
+            problems += duplicate_keys(item, path + (index,))
+    elif isinstance(node, MappingNode):
+        first_line: dict = {}
+        for key, value in node.value:
+            if key.tag == MERGE_TAG:
+                continue
+            name = scalar_key(key)
+            if name in first_line:
+                message = f"duplicate key '{name}' (first written at line {first_line[name]})"
+                problems.append(Problem(path + (name,), message, "remove one of the two", position=_position(key)))
+            else:
+                first_line[name] = _position(key)[0]
+            problems += duplicate_keys(value, path + (name,))
+    return problems
+
+
+def parse_yaml(text: str, file: str | Path) -> tuple[dict, SourceMap]:
+    """(document, source map); InputError for syntax errors, duplicate keys, a non-mapping top level."""
+    loader = yaml.SafeLoader(text)
+    try:
+        root = loader.get_single_node()
+        problems = duplicate_keys(root)
+        if problems:
+            raise InputError(problems, file, SourceMap.from_node(root))
+        source = SourceMap.from_node(root)
+        document = loader.construct_document(root) if root is not None else None
+    except yaml.YAMLError as exc:
+        raise InputError([_syntax_problem(exc)], file) from None
+    finally:
+        loader.dispose()
+    _check_top_level(document, root, file, source)
+    return document, source
+
+
+def _check_top_level(document: Any, root: Node | None, file, source: SourceMap) -> None:
+    if document is None:
+        raise InputError([Problem((), "the file is empty", "a mechanism file needs at least `bodies:` and `solver:`",
+                                  position=(1, 1))], file, source)
+    if not isinstance(document, dict):
+        found = "a list" if isinstance(document, list) else f"the value {document!r}"
+        problem = Problem((), f"the top level must be a mapping (key: value), found {found}",
+                          "start with keys such as `bodies:`, `joints:` and `solver:`", position=_position(root))
+        raise InputError([problem], file, source)
+
+
+# --- schema and names -----------------------------------------------------------------------------
+
+_NEEDED_FOR_NAMES = {("bodies",), ("points",), ("defaults",)}  # invalid: too little left to check names against
+_STAND_INS = {"solver": {"t_end": 1.0}}  # required sections that no name check reads
+
+
+def _invalid_items(exc: ValidationError) -> set[tuple]:
+    """The list items (("joints", 3)) and sections (("solver",)) that failed validation."""
+    invalid = set()
+    for error in exc.errors():
+        path = locate_error(tuple(error["loc"]), Mechanism).path
+        is_item = len(path) > 1 and path[0] in KINDS and isinstance(path[1], int)
+        invalid.add(path[:2] if is_item else path[:1])
+    return invalid
+
+
+def _name(item: Any) -> str | None:
+    name = item.get("name") if isinstance(item, dict) else None
+    return name if isinstance(name, str) else None
+
+
+def _references_of_valid_part(document: dict, exc: ValidationError) -> list[Problem]:
+    """Name checks on the valid items of a file that failed validation, so that one run reports all.
+
+    Invalid items are left out; references to their names are not reported again.
+    """
+    invalid = _invalid_items(exc)
+    if invalid & _NEEDED_FOR_NAMES:
+        return []
+    partial = {key: value for key, value in document.items() if (key,) not in invalid}
+    partial.update({key: value for key, value in _STAND_INS.items() if (key,) in invalid})
+    known = {}
+    for key in KINDS:
+        items = partial.get(key)
+        if isinstance(items, list):
+            partial[key] = [item for index, item in enumerate(items) if (key, index) not in invalid]
+            known[key] = {_name(item) for index, item in enumerate(items) if (key, index) in invalid}
+    try:
+        return check_references(Mechanism.model_validate(partial), known)
+    except ValidationError:
+        return []
+
+
+# --- loading --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class LoadedMechanism:
+    mechanism: Mechanism
+    path: Path
+    source: SourceMap
+    resolved_yaml: str  # the YAML text after overrides: enough to reproduce the run
+    base_dir: Path  # relative file names (CSV tables) are read from here
+
+
+def load_mechanism(path: str | Path, overrides: Sequence[str] = ()) -> LoadedMechanism:
+    """Read, override, validate and cross-check a mechanism file; InputError lists every problem."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise InputError([Problem((), f"cannot read the file: {reason}", "check the path")], path) from None
+    return load_mechanism_text(text, name=str(path), overrides=overrides, base_dir=path.parent)
+
+
+def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[str] = (),
+                        base_dir: Path | None = None) -> LoadedMechanism:
+    """As load_mechanism, from YAML text (`name` is used in messages)."""
+    document, source = parse_yaml(text, name)
+    source.overrides, problems = apply_overrides(document, list(overrides), Mechanism)
+    mechanism = None
+    try:
+        mechanism = Mechanism.model_validate(document)
+        problems += check_references(mechanism)
+    except ValidationError as exc:
+        problems += validation_problems(exc, document, Mechanism) + _references_of_valid_part(document, exc)
+    if problems:
+        raise InputError(problems, name, source)
+    resolved = yaml.safe_dump(document, sort_keys=False, allow_unicode=True)
+    return LoadedMechanism(mechanism, Path(name), source, resolved, base_dir or Path.cwd())

@@ -1,0 +1,132 @@
+"""`clearsim` end to end: the commands of issue #2 on short runs, exit codes and messages."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import h5py
+import pytest
+from typer.testing import CliRunner
+
+from clearsim import __version__
+from clearsim.cli import app
+
+CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
+SLIDER_CRANK = str(CONFIGS / "slider_crank_flores.yaml")
+runner = CliRunner()
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def test_version():
+    result = invoke("--version")
+    assert result.exit_code == 0 and __version__ in result.output
+
+
+def test_run_writes_the_file_and_prints_the_summary(tmp_path):
+    out = tmp_path / "sc.h5"
+    result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=2ms")
+    assert result.exit_code == 0, result.output
+    for text in ("peak |slider_velocity|", "peak |slider_acceleration|", "max contact force, joint slider_pin",
+                 "steps (rejected)", "contact events", "wall time"):
+        assert text in result.output
+    with h5py.File(out) as f:
+        assert bool(f.attrs["complete"]) and f["time"][-1] == pytest.approx(0.002)
+
+
+def test_rerun_keeps_the_earlier_result(tmp_path):
+    out = tmp_path / "sc.h5"
+    for _ in range(2):
+        result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=1ms")
+        assert result.exit_code == 0, result.output
+    assert "kept the earlier result as" in result.output and (tmp_path / "sc.1.h5").exists()
+
+
+def test_override_makes_the_clearance_joint_ideal(tmp_path):
+    out = tmp_path / "ideal.h5"
+    result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=1ms", "--set", "joints.slider_pin.clearance=0")
+    assert result.exit_code == 0, result.output
+    with h5py.File(out) as f:
+        assert "joints/slider_pin/reaction" in f and "joints/slider_pin/penetration" not in f
+
+
+def test_validate_and_schema(tmp_path):
+    result = invoke("validate", SLIDER_CRANK)
+    assert result.exit_code == 0 and "OK" in result.output and "2 degrees of freedom" in result.output
+    schema = json.loads(invoke("schema").output)
+    assert {"bodies", "joints", "solver"} <= set(schema["properties"])
+
+
+REDUNDANT = """
+name: body pinned to the ground twice
+points: {O: [0 m, 0 m], P: [0.2 m, 0 m]}
+bodies:
+  - {name: bar, mass: 1 kg, inertia: 0.01 kg*m^2, position: [0.1 m, 0 m]}
+joints:
+  - {name: first_pin, type: revolute, bodies: [ground, bar], at: O}
+  - {name: second_pin, type: revolute, bodies: [ground, bar], at: P}
+solver: {t_end: 1 ms}
+"""
+
+NOT_ASSEMBLING = """
+name: two cranks too short to meet
+points: {O: [0 m, 0 m], Q: [1 m, 0 m]}
+bodies:
+  - {name: left, mass: 1 kg, inertia: 0.01 kg*m^2, position: [0.05 m, 0 m], points: {tip: [0.05 m, 0 m]}}
+  - {name: right, mass: 1 kg, inertia: 0.01 kg*m^2, position: [0.95 m, 0 m], points: {tip: [-0.05 m, 0 m]}}
+joints:
+  - {name: left_pivot, type: revolute, bodies: [ground, left], at: O}
+  - {name: right_pivot, type: revolute, bodies: [ground, right], at: Q}
+  - {name: coupler_pin, type: revolute, bodies: [left, right], points: [tip, tip]}
+solver: {t_end: 1 ms}
+"""
+
+
+@pytest.mark.parametrize("text, expected", [
+    (REDUNDANT, ["redundant constraints", "first_pin", "second_pin"]),
+    (NOT_ASSEMBLING, ["cannot be assembled", "coupler_pin"]),
+    ("bodies: [\n", ["bad.yaml:"]),
+])
+def test_bad_mechanisms_give_one_located_message_and_exit_2(tmp_path, text, expected):
+    config = tmp_path / "bad.yaml"
+    config.write_text(text)
+    out = tmp_path / "never.h5"
+    result = invoke("run", config, "-o", out)
+    assert result.exit_code == 2
+    assert "Traceback" not in result.output
+    for fragment in expected:
+        assert fragment in result.output
+    assert not out.exists()
+
+
+def test_solver_failure_exits_2_with_time_and_joint_and_keeps_partial_results(tmp_path):
+    out = tmp_path / "failed.h5"
+    result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=3ms", "--set", "solver.min_step=2e-5s")
+    assert result.exit_code == 2
+    assert "slider_pin" in result.output and "ms" in result.output and "Traceback" not in result.output
+    with h5py.File(out) as f:
+        assert not f.attrs["complete"] and f["time"].shape[0] > 1
+
+
+def test_sigterm_leaves_a_flagged_readable_file(tmp_path):
+    out = tmp_path / "killed.h5"
+    command = [sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out),
+               "--set", "solver.t_end=2s", "--set", "solver.output_rate=10kHz"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=os.environ.copy())
+    deadline = time.time() + 120
+    while not out.exists() and time.time() < deadline and process.poll() is None:
+        time.sleep(0.2)
+    time.sleep(1.0)
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr.decode()
+    assert b"Traceback" not in stderr
+    with h5py.File(out) as f:
+        assert not f.attrs["complete"] and str(f.attrs["status"]).startswith("interrupted")
+        assert 0.0 < f["time"][-1] < 2.0

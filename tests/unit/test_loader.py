@@ -1,0 +1,286 @@
+"""Loading a mechanism file: a valid slider-crank, located messages for bad files, `--set` overrides."""
+
+import math
+
+import pytest
+import yaml
+
+from clearsim.errors import InputError, Problem, SolverError
+from clearsim.model.loader import SourceMap, load_mechanism, load_mechanism_text
+from clearsim.model.resolve import resolve_clearance
+
+SLIDER_CRANK = """\
+name: slider-crank
+defaults:
+  bearing_radius: 10 mm
+  material: {youngs_modulus: 207 GPa, poisson_ratio: 0.3}
+  contact: {law: lankarani_nikravesh, restitution: 0.9, exponent: 1.5, stiffness: auto}
+  friction: {law: stiction_step, mu_s: 0.2, mu_d: 0.16, v_s: 1e-4 m/s, v_d: 1e-2 m/s}
+points:
+  O: [0 m, 0 m]
+  A: [0.05 m, 0 m]
+  B: [0.17 m, 0 m]
+bodies:
+  - name: crank
+    mass: 0.30 kg
+    inertia: 0.0001 kg*m^2
+    position: [0.025 m, 0 m]
+  - name: rod
+    mass: 0.21 kg
+    inertia: 0.00025 kg*m^2
+    position: [0.11 m, 0 m]
+  - name: slider
+    mass: 0.14 kg
+    inertia: 0.0001 kg*m^2
+    position: [0.17 m, 0 m]
+joints:
+  - {name: O, type: revolute, bodies: [ground, crank], at: O}
+  - {name: A, type: revolute, bodies: [crank, rod], at: A, clearance: 0.1 mm}
+  - {name: B, type: revolute, bodies: [rod, slider], at: B}
+  - {name: guide, type: prismatic, bodies: [ground, slider], at: B, axis: [1, 0]}
+drivers:
+  - {name: crank_drive, joint: O, motion: {law: constant_speed, speed: 5000 rpm}}
+sensors:
+  - {name: slider_x, type: point_displacement, body: slider, direction: [1, 0]}
+  - {name: slider_v, type: point_velocity, body: slider, direction: [1, 0]}
+  - {name: slider_a, type: point_acceleration, body: slider, direction: [1, 0]}
+  - {name: crank_angle, type: body_angle, body: crank}
+output: {displacement: slider_x, velocity: slider_v, acceleration: slider_a}
+solver: {t_end: 24 ms, output_rate: 100 kHz, rtol: 1e-7, max_step: 0.1 ms}
+"""
+
+
+def edited(old: str, new: str) -> str:
+    assert SLIDER_CRANK.count(old) == 1, old
+    return SLIDER_CRANK.replace(old, new)
+
+
+def line_of(text: str, fragment: str) -> int:
+    lines = [number for number, line in enumerate(text.splitlines(), 1) if fragment in line]
+    assert len(lines) == 1, fragment
+    return lines[0]
+
+
+def load_error(text: str, *overrides: str) -> str:
+    with pytest.raises(InputError) as info:
+        load_mechanism_text(text, "sc.yaml", overrides=overrides)
+    return str(info.value)
+
+
+# --- a valid file ---------------------------------------------------------------------------------
+
+
+def test_the_slider_crank_loads_in_si_units():
+    loaded = load_mechanism_text(SLIDER_CRANK, "sc.yaml")
+    m = loaded.mechanism
+    assert [b.name for b in m.bodies] == ["crank", "rod", "slider"]
+    assert m.body("crank").inertia == pytest.approx(1e-4) and m.points["B"] == pytest.approx((0.17, 0.0))
+    assert m.drivers[0].motion.speed == "5000 rpm"  # converted where the driven coordinate is known
+    assert (m.solver.t_end, m.solver.output_rate, m.solver.max_step) == pytest.approx((0.024, 1e5, 1e-4))
+    assert m.joint("A").clearance == pytest.approx(1e-4)
+    assert [resolve_clearance(m.joint(n), m.defaults) is None for n in ("O", "A", "B")] == [True, False, True]
+
+
+def test_resolved_yaml_reproduces_the_mechanism():
+    loaded = load_mechanism_text(SLIDER_CRANK, overrides=["joints.A.clearance=0.2mm"])
+    again = load_mechanism_text(loaded.resolved_yaml)
+    assert again.mechanism == loaded.mechanism and again.mechanism.joint("A").clearance == pytest.approx(2e-4)
+    assert list(yaml.safe_load(loaded.resolved_yaml))[:3] == ["name", "defaults", "points"]  # file order kept
+
+
+def test_file_path_and_base_dir(tmp_path):
+    config = tmp_path / "sc.yaml"
+    config.write_text(SLIDER_CRANK)
+    loaded = load_mechanism(config)
+    assert loaded.path == config and loaded.base_dir == tmp_path
+    config.write_text(edited("mass: 0.21 kg", "mass: 0.21 m"))
+    with pytest.raises(InputError) as info:
+        load_mechanism(config)
+    assert str(info.value).startswith(f"{config}:{line_of(SLIDER_CRANK, 'mass: 0.21 kg')}:11  bodies[1] 'rod' → mass")
+
+
+def test_missing_file_is_an_input_error(tmp_path):
+    with pytest.raises(InputError, match="cannot read the file"):
+        load_mechanism(tmp_path / "nowhere.yaml")
+
+
+def test_source_map_locates_keys_items_and_names():
+    source = SourceMap.from_text(SLIDER_CRANK)
+    joints_line = line_of(SLIDER_CRANK, "{name: A,")
+    assert source.positions[("joints", 1)] == (joints_line, 5)
+    assert source.positions[("joints", 1, "bodies", 1)] == (joints_line, 47)  # the "rod" of [crank, rod]
+    assert source.positions[("bodies", 1, "mass")] == (line_of(SLIDER_CRANK, "mass: 0.21"), 11)
+    assert source.positions[("bodies",)] == (SLIDER_CRANK.splitlines().index("bodies:") + 1, 1)  # block: at the key
+    assert source.names[("joints", 3)] == "guide" and source.names[("bodies", 0)] == "crank"
+    assert source.locate(("joints", 1, "contact", "restitution")) == ((joints_line, 5), ("joints", 1))
+
+
+# --- bad files: located message, exact text -------------------------------------------------------
+
+BAD_FILES = {
+    "malformed yaml": ("bodies: [ground, crank]", "bodies: [ground, crank", "{name: O,",
+                       ["invalid YAML", "expected ',' or ']'"]),
+    "tab": ("  O: [0 m, 0 m]", "\tO: [0 m, 0 m]", "\tO:", ["indent with spaces: YAML does not allow tabs"]),
+    "duplicate key": ("mass: 0.21 kg", "mass: 0.21 kg\n    mass: 0.3 kg", "mass: 0.3 kg",
+                      ["bodies[1] 'rod' → mass", "duplicate key 'mass' (first written at line"]),
+    "unknown key": ("    mass: 0.14 kg", "    mas: 0.14 kg", "mas: 0.14",
+                    ["bodies[2] 'slider' → mas", "unknown key 'mas'; did you mean 'mass'?", "allowed keys here: name"]),
+    "unknown body": ("bodies: [crank, rod]", "bodies: [crank, rood]", "rood",
+                     ["joints[1] 'A' → bodies[1]", "unknown body 'rood'; did you mean 'rod'?"]),
+    "unknown point": ("at: A,", "at: Q,", "at: Q,", ["joints[1] 'A' → at", "unknown point 'Q'", "points:"]),
+    "negative mass": ("mass: 0.30 kg", "mass: -0.30 kg", "mass: -0.30", ["must be greater than 0, got -0.3"]),
+    "wrong unit": ("mass: 0.30 kg", "mass: 0.30 mm", "mass: 0.30", ["expected a mass (e.g. '3.67 kg'), got '0.30 mm'"]),
+    "missing key": ("    mass: 0.30 kg\n", "", "- name: crank", ["bodies[0] 'crank'\n", "missing required key 'mass'"]),
+    "bad joint type": ("type: prismatic", "type: prismatc", "prismatc",
+                       ["joints[3] 'guide' → type", "unknown type 'prismatc'; did you mean 'prismatic'?",
+                        "allowed: revolute, prismatic"]),
+    "clearance >= bearing radius": ("clearance: 0.1 mm", "clearance: 10 mm", "clearance: 10 mm",
+                                    ["clearance 10 mm must be smaller than the bearing radius 10 mm"]),
+    "restitution above 1": ("restitution: 0.9", "restitution: 1.2", "restitution: 1.2",
+                            ["defaults → contact → restitution", "must be at most 1, got 1.2"]),
+    "restitution 0": ("at: A, clearance: 0.1 mm", "at: A, clearance: 0.1 mm, contact: {restitution: 0}",
+                      "restitution: 0}", ["must be greater than 0, got 0", "0 < c_e <= 1"]),
+    "duplicate joint name": ("{name: B,", "{name: A,", "bodies: [rod, slider]",
+                             ["joints[2] 'A' → name", "duplicate joint name 'A' (also joints[1])"]),
+    "driver on unknown joint": ("joint: O,", "joint: guid,", "joint: guid",
+                                ["drivers[0] 'crank_drive' → joint", "unknown joint 'guid'; did you mean 'guide'?"]),
+    "driver on clearance joint": ("joint: O,", "joint: A,", "crank_drive",
+                                  ["joint 'A' has a clearance; a driver needs an ideal joint"]),
+    "sensor on unknown body": ("body: crank}", "body: crankk}", "crankk",
+                               ["sensors[3] 'crank_angle' → body", "unknown body 'crankk'; did you mean 'crank'?"]),
+    "output of the wrong type": ("velocity: slider_v", "velocity: slider_x", "output:",
+                                 ["output velocity must be a point_velocity sensor; 'slider_x' is a point_displacement",
+                                  "point_velocity sensors in the file: slider_v"]),
+    "missing friction parameter": ("mu_s: 0.2, ", "", "friction: {law",
+                                   ["defaults → friction → law", "friction law 'stiction_step' needs mu_s"]),
+    "v_s >= v_d": ("v_s: 1e-4 m/s", "v_s: 0.1 m/s", "v_s: 0.1", ["v_s = 0.1 m/s must be smaller than v_d = 0.01 m/s"]),
+    "missing bearing radius": ("  bearing_radius: 10 mm\n", "", "clearance: 0.1 mm",
+                               ["a clearance joint needs a bearing radius", "bearing_radius: 50 mm"]),
+    "unknown motion law": ("law: constant_speed", "law: constant_sped", "crank_drive",
+                           ["unknown law 'constant_sped'; did you mean 'constant_speed'?"]),
+    "ground as a body name": ("- name: slider\n", "- name: ground\n", "name: ground", ["'ground' is reserved"]),
+    "joint without location": ("bodies: [ground, crank], at: O}", "bodies: [ground, crank]}", "{name: O,",
+                               ["joint 'O' has no location", "`at:`"]),
+    "top level not a mapping": (SLIDER_CRANK, "- bodies\n- joints\n", "- bodies",
+                                ["the top level must be a mapping (key: value), found a list"]),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_FILES), ids=list(BAD_FILES))
+def test_bad_file_gives_located_message(case):
+    old, new, marker, fragments = BAD_FILES[case]
+    text = edited(old, new)
+    message = load_error(text)
+    assert f"sc.yaml:{line_of(text, marker)}:" in message, message
+    for fragment in fragments:
+        assert fragment in message, message
+    assert "Value error" not in message and "pydantic" not in message
+
+
+def test_empty_file():
+    assert "sc.yaml:1:1\n  the file is empty" in load_error("# nothing here\n")
+
+
+def test_all_problems_of_a_file_are_reported_in_file_order():
+    text = edited("bodies: [crank, rod]", "bodies: [crank, rood]").replace("mass: 0.30 kg", "mass: -1 kg")
+    message = load_error(text)
+    mass_line, body_line = line_of(text, "mass: -1 kg"), line_of(text, "rood")
+    assert f"sc.yaml:{mass_line}:11  bodies[0] 'crank' → mass\n  must be greater than 0, got -1.0" in message
+    assert f"sc.yaml:{body_line}:47  joints[1] 'A' → bodies[1]\n  unknown body 'rood'" in message
+    assert message.index("got -1.0") < message.index("rood")
+
+
+def test_name_checks_run_even_when_the_schema_fails():
+    text = edited("solver: {t_end: 24 ms, output_rate: 100 kHz, rtol: 1e-7, max_step: 0.1 ms}\n", "")
+    text = text.replace("body: crank}", "body: crankk}").replace("mass: 0.21 kg", "mass: 0.21 m")
+    message = load_error(text)
+    assert "missing required key 'solver'" in message and "unknown body 'crankk'" in message
+    assert "expected a mass" in message
+    assert "unknown body 'rod'" not in message  # the invalid body is reported once, not again where it is used
+
+
+def test_a_path_not_in_the_file_points_at_its_nearest_ancestor_and_says_so():
+    source = SourceMap.from_text(SLIDER_CRANK)
+    error = InputError([Problem(("joints", 1, "contact", "restitution"), "too soft", "raise it")], "sc.yaml", source)
+    line = line_of(SLIDER_CRANK, "{name: A,")
+    assert str(error) == (f"sc.yaml:{line}:5  joints[1] 'A' → contact → restitution  (not in the file; shown at "
+                          f"joints[1] 'A')\n  too soft\n  hint: raise it")
+
+
+def test_solver_error_names_time_and_joint():
+    error = SolverError("the step size fell below solver.min_step", time=0.01241, element="J", hint="lower min_step")
+    assert str(error) == "at t = 12.41 ms, joint J: the step size fell below solver.min_step. lower min_step"
+
+
+# --- overrides ------------------------------------------------------------------------------------
+
+VALID_OVERRIDES = {
+    "joints.A.clearance=0.05mm": (lambda m: m.joint("A").clearance, 5e-5),
+    "joints.A.contact.restitution=0.8": (lambda m: m.joint("A").contact.restitution, 0.8),  # `contact:` created
+    "joints.A.friction.mu_d=0.1": (lambda m: resolve_clearance(m.joint("A"), m.defaults).mu_d, 0.1),
+    "bodies.rod.mass=6kg": (lambda m: m.body("rod").mass, 6.0),
+    "solver.rtol=1e-8": (lambda m: m.solver.rtol, 1e-8),
+    "solver.t_end=20ms": (lambda m: m.solver.t_end, 0.02),
+    "solver.output_rate=50kHz": (lambda m: m.solver.output_rate, 5e4),
+    "defaults.bearing_radius=20 mm": (lambda m: resolve_clearance(m.joint("A"), m.defaults).bearing_radius, 0.02),
+    "drivers.crank_drive.motion.speed=100 rad/s": (lambda m: m.drivers[0].motion.speed, "100 rad/s"),
+}
+
+
+@pytest.mark.parametrize("override", list(VALID_OVERRIDES))
+def test_override_changes_the_value(override):
+    get, expected = VALID_OVERRIDES[override]
+    before = get(load_mechanism_text(SLIDER_CRANK).mechanism) if "contact" not in override else None
+    after = get(load_mechanism_text(SLIDER_CRANK, overrides=[override]).mechanism)
+    assert after == pytest.approx(expected) if not isinstance(expected, str) else after == expected
+    assert before != after
+
+
+def test_clearance_zero_makes_the_joint_ideal():
+    m = load_mechanism_text(SLIDER_CRANK, overrides=["joints.A.clearance=0"]).mechanism
+    assert resolve_clearance(m.joint("A"), m.defaults) is None
+
+
+def test_clearance_on_an_ideal_joint_makes_a_clearance_joint_with_the_defaults():
+    m = load_mechanism_text(SLIDER_CRANK, overrides=["joints.B.clearance=0.05mm"]).mechanism
+    p = resolve_clearance(m.joint("B"), m.defaults)
+    assert (p.bearing_radius, p.journal_radius, p.clearance) == pytest.approx((0.01, 0.00995, 5e-5))
+    assert (p.restitution, p.friction_law, p.mu_s, p.v_high) == (0.9, "stiction_step", 0.2, 1e-2)
+
+
+def test_clearance_override_keeps_the_bearing_radius_of_a_joint_given_by_two_radii():
+    text = edited("at: A, clearance: 0.1 mm", "at: A, bearing_radius: 12 mm, journal_radius: 11.5 mm")
+    m = load_mechanism_text(text, overrides=["joints.A.clearance=0.02mm"]).mechanism
+    p = resolve_clearance(m.joint("A"), m.defaults)
+    assert (p.bearing_radius, p.journal_radius, p.clearance) == pytest.approx((0.012, 0.01198, 2e-5))
+
+
+@pytest.mark.parametrize("override, fragments", [
+    ("joints.X.clearance=0.1mm", ["no joint named 'X'", "joints in the file: O, A, B, guide"]),
+    ("joints.gide.clearance=0.1mm", ["no joint named 'gide'; did you mean 'guide'?"]),
+    ("bodies.rood.mass=1kg", ["no body named 'rood'; did you mean 'rod'?"]),
+    ("joints.A.clearence=0.1mm", ["unknown key 'clearence' in joints.A; did you mean 'clearance'?"]),
+    ("joints.guide.clearance=0.1mm", ["unknown key 'clearance' in joints.guide", "allowed keys here: name, type"]),
+    ("joints.A.friction.mu_x=0.1", ["unknown key 'mu_x' in joints.A.friction"]),
+    ("drivers.crank_drive.motion.sped=1", ["unknown key 'sped' in drivers.crank_drive.motion; did you mean 'speed'?"]),
+    ("solver.tend=1ms", ["unknown key 'tend' in solver; did you mean 't_end'?"]),
+    ("solver.t_end", ["an override is written path=value"]),
+    ("solver.t_end.x=1", ["'solver.t_end' holds a single value, not keys"]),
+])
+def test_bad_override_is_reported_at_the_override(override, fragments):
+    message = load_error(SLIDER_CRANK, override)
+    assert message.startswith(f"in --set {override}\n"), message
+    for fragment in fragments:
+        assert fragment in message, message
+
+
+def test_a_bad_value_from_an_override_is_reported_at_the_override():
+    message = load_error(SLIDER_CRANK, "joints.A.clearance=20mm", "solver.t_end=20 kg")
+    assert "in --set joints.A.clearance=20mm  joints[1] 'A' → clearance\n  clearance 20 mm must be smaller" in message
+    assert "in --set solver.t_end=20 kg  solver → t_end\n  expected a time" in message
+
+
+def test_override_values_are_read_as_yaml():
+    m = load_mechanism_text(SLIDER_CRANK, overrides=["solver.atol=1e-12", "gravity=[0, -9.81 m/s^2]"]).mechanism
+    assert m.solver.atol == 1e-12 and m.gravity == pytest.approx((0.0, -9.81))
+    assert math.isclose(m.solver.rtol, 1e-7)

@@ -1,0 +1,61 @@
+"""Unit strings → SI floats, and errors that name the expected kind."""
+
+import math
+
+import pytest
+
+from clearsim.units import UnitError, contact_stiffness_to_si, to_si
+
+
+@pytest.mark.parametrize("text, kind, si", [
+    ("0.01 mm", "length", 1e-5),
+    ("5000 rpm", "angular_speed", 5000 * 2 * math.pi / 60),  # 523.598... rad/s
+    ("30 deg", "angle", math.pi / 6),  # 0.5236 rad
+    ("207 GPa", "pressure", 207e9),
+    ("85 ms", "time", 0.085),
+    ("100 kHz", "frequency", 1e5),
+    ("1e-4 m/s", "speed", 1e-4),
+    ("0.044 kg*m^2", "inertia", 0.044),
+    ("3.67 kg", "mass", 3.67),
+])
+def test_unit_strings_convert_to_si(text, kind, si):
+    assert to_si(text, kind) == pytest.approx(si, rel=1e-12)
+
+
+def test_rpm_and_degrees_by_hand():
+    assert to_si("5000 rpm", "angular_speed") == pytest.approx(523.5987756, rel=1e-9)
+    assert to_si("30 deg", "angle") == pytest.approx(0.5235987756, rel=1e-9)
+
+
+def test_a_bare_number_is_si():
+    assert to_si(0.25, "length") == 0.25
+    assert to_si(3, "mass") == 3.0
+
+
+def test_contact_stiffness_in_n_per_m_to_the_exponent():
+    assert contact_stiffness_to_si("1.205e12 N/m^1.5", 1.5) == pytest.approx(1.205e12, rel=1e-12)
+    # Meng 2015 Table 2: K = 3.81e7 in Adams' N/mm^1.5 is 3.81e7 · 1000^1.5 N/m^1.5
+    assert contact_stiffness_to_si("3.81e7 N/mm^1.5", 1.5) == pytest.approx(3.81e7 * 1000**1.5, rel=1e-12)
+    assert contact_stiffness_to_si(2e9, 1.0) == 2e9
+
+
+def test_contact_stiffness_of_the_wrong_exponent_is_an_error():
+    with pytest.raises(UnitError, match=r"N/m\^1\.5"):
+        contact_stiffness_to_si("1e5 N/m", 1.5)
+
+
+def test_wrong_kind_names_the_expected_kind():
+    with pytest.raises(UnitError) as info:
+        to_si("0.01 kg", "length")
+    message = str(info.value)
+    assert "expected a length" in message and "0.01 mm" in message and "'0.01 kg'" in message
+
+
+def test_unknown_unit_is_an_error():
+    with pytest.raises(UnitError, match="unknown unit"):
+        to_si("3 furlongz", "length")
+
+
+def test_a_boolean_is_not_a_number():
+    with pytest.raises(UnitError):
+        to_si(True, "length")

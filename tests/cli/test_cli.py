@@ -130,3 +130,19 @@ def test_sigterm_leaves_a_flagged_readable_file(tmp_path):
     with h5py.File(out) as f:
         assert not f.attrs["complete"] and str(f.attrs["status"]).startswith("interrupted")
         assert 0.0 < f["time"][-1] < 2.0
+
+
+from tests.unit.test_loader import BAD_FILES, edited  # noqa: E402  (the same bad files, through the CLI)
+
+
+@pytest.mark.parametrize("case", list(BAD_FILES), ids=list(BAD_FILES))
+def test_every_bad_file_exits_2_from_the_cli_without_traceback_or_output(tmp_path, case):
+    old, new, _, fragments = BAD_FILES[case]
+    config = tmp_path / "sc.yaml"
+    config.write_text(edited(old, new))
+    out = tmp_path / "never.h5"
+    result = invoke("run", config, "-o", out)
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output and "sc.yaml:" in result.output
+    assert fragments[-1].split("\n")[0] in result.output
+    assert not out.exists()

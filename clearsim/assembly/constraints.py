@@ -30,6 +30,14 @@ def prescribed(system, law, t):
 
 
 @njit(cache=True)
+def _arms(q, bi, bj, p):
+    """A_i s_i and A_j s_j (global), the joint points of a row's parameters p = [s_i, s_j, …]."""
+    aix, aiy = rotate(body_pose(q, bi)[2], p[OFF_POINT_I], p[OFF_POINT_I + 1])
+    ajx, ajy = rotate(body_pose(q, bj)[2], p[OFF_POINT_J], p[OFF_POINT_J + 1])
+    return aix, aiy, ajx, ajy
+
+
+@njit(cache=True)
 def _offset_terms(system, k, q):
     """w = A_i w̄ and d = P_j − P_i of offset row k."""
     bi = system.offset_bodies[k, 0]
@@ -77,9 +85,7 @@ def evaluate_jacobian(system, q, jac):
     for k in range(system.pin_bodies.shape[0]):
         bi = system.pin_bodies[k, 0]
         bj = system.pin_bodies[k, 1]
-        s = system.pin_points[k]
-        aix, aiy = rotate(body_pose(q, bi)[2], s[0], s[1])
-        ajx, ajy = rotate(body_pose(q, bj)[2], s[2], s[3])
+        aix, aiy, ajx, ajy = _arms(q, bi, bj, system.pin_points[k])
         for axis in range(2):
             _set(jac, row + axis, bi, axis, 1.0)
             _set(jac, row + axis, bj, axis, -1.0)
@@ -91,10 +97,8 @@ def evaluate_jacobian(system, q, jac):
     for k in range(system.offset_bodies.shape[0]):
         bi = system.offset_bodies[k, 0]
         bj = system.offset_bodies[k, 1]
-        p = system.offset_params[k]
         wx, wy, dx, dy = _offset_terms(system, k, q)
-        aix, aiy = rotate(body_pose(q, bi)[2], p[OFF_POINT_I], p[OFF_POINT_I + 1])
-        ajx, ajy = rotate(body_pose(q, bj)[2], p[OFF_POINT_J], p[OFF_POINT_J + 1])
+        aix, aiy, ajx, ajy = _arms(q, bi, bj, system.offset_params[k])
         _set(jac, row, bi, 0, -wx)
         _set(jac, row, bi, 1, -wy)
         _set(jac, row, bj, 0, wx)
@@ -129,11 +133,9 @@ def evaluate_acceleration_rhs(system, t, q, qd, gamma):
     for k in range(system.pin_bodies.shape[0]):
         bi = system.pin_bodies[k, 0]
         bj = system.pin_bodies[k, 1]
-        s = system.pin_points[k]
         wi = body_rates(qd, bi)[2]
         wj = body_rates(qd, bj)[2]
-        aix, aiy = rotate(body_pose(q, bi)[2], s[0], s[1])
-        ajx, ajy = rotate(body_pose(q, bj)[2], s[2], s[3])
+        aix, aiy, ajx, ajy = _arms(q, bi, bj, system.pin_points[k])
         gamma[row] = aix * wi * wi - ajx * wj * wj
         gamma[row + 1] = aiy * wi * wi - ajy * wj * wj
         row += 2
@@ -146,8 +148,7 @@ def evaluate_acceleration_rhs(system, t, q, qd, gamma):
         wx, wy, dx, dy = _offset_terms(system, k, q)
         vix, viy = point_velocity(q, qd, bi, p[OFF_POINT_I], p[OFF_POINT_I + 1])
         vjx, vjy = point_velocity(q, qd, bj, p[OFF_POINT_J], p[OFF_POINT_J + 1])
-        aix, aiy = rotate(body_pose(q, bi)[2], p[OFF_POINT_I], p[OFF_POINT_I + 1])
-        ajx, ajy = rotate(body_pose(q, bj)[2], p[OFF_POINT_J], p[OFF_POINT_J + 1])
+        aix, aiy, ajx, ajy = _arms(q, bi, bj, p)
         centripetal = wx * (ajx * wj * wj - aix * wi * wi) + wy * (ajy * wj * wj - aiy * wi * wi)
         turning = wi * wi * (wx * dx + wy * dy) - 2.0 * wi * (-wy * (vjx - vix) + wx * (vjy - viy))
         gamma[row] = centripetal + turning + prescribed(system, system.offset_law[k], t)[2]

@@ -171,7 +171,8 @@ def add_driver(rows: ConstraintRows, laws: Laws, mechanism, poses: Poses, driver
         if isinstance(joint, schema.PrismaticJoint):
             axis_body = _rotation(poses.pose(bi)[1]).T @ np.asarray(joint.axis, float)
             law = laws.add(_motion_law(driver, "length", base_dir, path))
-            rows.offsets.append((bi, bj, si, sj, axis_body, 0.0, law, driver.name))
+            start = np.dot(joint.axis, poses.to_global(bj, sj) - poses.to_global(bi, si))  # 0 for `at:`
+            rows.offsets.append((bi, bj, si, sj, axis_body, start, law, driver.name))
         else:
             law = laws.add(_motion_law(driver, "angle", base_dir, path))
             rows.angles.append((bi, bj, poses.pose(bj)[1] - poses.pose(bi)[1], law, driver.name))

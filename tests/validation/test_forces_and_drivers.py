@@ -90,3 +90,19 @@ def test_drivers_follow_their_laws(simulate, tmp_path):
     assert np.allclose(carriage[:, 1], 0.03 * tau**2 * (3 - 2 * tau), atol=1e-10)
     assert np.allclose(carriage[:, 2], 2 * np.pi * t, atol=1e-10)
     assert np.allclose(result["bodies/carriage/qdd"][:, 0], 0.0, atol=1e-6)
+
+
+def test_a_driven_prismatic_joint_located_by_points_starts_where_the_file_puts_it(simulate):
+    text = """
+name: carriage on a guide, joint located by named points
+bodies:
+  - {name: carriage, mass: 1 kg, inertia: 0.01 kg*m^2, position: [0.1 m, 0 m], points: {centre: [0 m, 0 m]}}
+points: {origin: [0 m, 0 m]}
+joints:
+  - {name: guide, type: prismatic, bodies: [ground, carriage], points: [origin, centre], axis: [1, 0]}
+drivers:
+  - {name: push, joint: guide, motion: {law: constant_speed, speed: 2 m/s}}
+solver: {t_end: 10 ms, output_rate: 1 kHz}
+"""
+    result = simulate(text)
+    assert np.allclose(result["bodies/carriage/q"][:, 0], 0.1 + 2.0 * result["time"], atol=1e-12)

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from clearsim.assembly.arrays import CL_CLEARANCE, CL_MIN_IMPACT_SPEED, CL_STIFFNESS, CL_EXPONENT
+from clearsim.assembly.arrays import CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_STIFFNESS
 from clearsim.assembly.dynamics import (
     coordinate_count, effective_mass, project_positions, project_velocities, rhs,
 )
@@ -40,6 +40,7 @@ SUBDIVISIONS = 4  # points per step at which the event functions are sampled
 PROJECTION_TOLERANCE = 1e-13  # m (rad): max |Φ| kept after each step
 DRIFT_LIMIT = 1e-8  # m: a projection that cannot get below this has lost the assembly
 SAFETY = 0.9
+DEEPEST_PENETRATION = 0.05  # of the journal radius: beyond it no contact law means anything
 
 
 @njit(cache=True)
@@ -336,7 +337,7 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             real[R_STEP] = min(real[R_STEP], suggested)
         update_peaks(system, y, modes, speeds, peak_force)
         for k in range(modes.shape[0]):
-            if event_value(system, k, y, FREE)[0] > system.clearance_params[k, CL_CLEARANCE]:
+            if event_value(system, k, y, FREE)[0] > DEEPEST_PENETRATION * system.clearance_params[k, CL_JOURNAL_RADIUS]:
                 ints[I_STATUS] = TOO_DEEP
                 ints[I_FAIL_JOINT] = k
                 return

@@ -177,7 +177,7 @@ class Run:
                             "check masses, inertias, stiffness and force units for values off by orders of magnitude"),
             ig.DRIFT: ("the constraints could not be satisfied any more (assembly lost)",
                        "the mechanism reaches a toggle or singular position here: check the geometry and the drive stroke"),
-            ig.TOO_DEEP: ("the journal penetrated deeper than the clearance",
+            ig.TOO_DEEP: ("the penetration exceeded 5 % of the journal radius, far outside any contact law's range",
                           "the contact stiffness is far too low for the load: check `stiffness` and its unit (N/m^1.5)"),
         }
         message, hint = messages[status]
@@ -189,12 +189,12 @@ class Run:
             m = constraint_count(system.arrays)
             phi = np.zeros(m)
             evaluate_constraints(system.arrays, self.time, self.y[: self.coordinate_count], phi)
-            return f"joint {system.row_owners[int(np.argmax(np.abs(phi)))]}" if m else None
+            return system.row_owners[int(np.argmax(np.abs(phi)))] if m else None
         if status == ig.TOO_DEEP:
-            return f"joint {system.clearance_joints[int(self.ints[ig.I_FAIL_JOINT])]}"
+            return system.clearance_joints[int(self.ints[ig.I_FAIL_JOINT])]
         in_contact = [k for k, mode in enumerate(self.modes) if mode != FREE]
         if in_contact:
-            return f"joint {system.clearance_joints[in_contact[0]]} (in contact)"
+            return f"{system.clearance_joints[in_contact[0]]} (in contact)"
         return None
 
 

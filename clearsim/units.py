@@ -132,6 +132,8 @@ def _quantity_type(kind: str):
             {
                 "anyOf": [{"type": "number"}, {"type": "string"}],
                 "description": f"{dimension.name}: a number in {dimension.si_unit} or a string with a unit, e.g. '{dimension.example}'",
+                "examples": [dimension.example],  # kept when a field's own description replaces the text above
+                "x-unit": dimension.si_unit,
             }
         ),
     ]

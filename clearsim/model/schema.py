@@ -57,7 +57,7 @@ class Material(Strict):
 class ContactSpec(Strict):
     """Normal contact law F = K δⁿ (1 + D(c_e) δ̇/δ̇⁻); every field optional at joint level."""
 
-    law: Literal["lankarani_nikravesh", "hertz", "hunt_crossley", "flores"] | None = None
+    law: Literal["lankarani_nikravesh", "hertz", "hunt_crossley", "flores"] | None = Field(None, description="contact force law (docs/model.md §3)")
     restitution: float | None = Field(None, gt=0.0, le=1.0, description="coefficient of restitution c_e, 0 < c_e <= 1")
     exponent: float | None = Field(None, gt=0.0, le=3.0, description="force exponent n (1.5 for metals)")
     stiffness: RawQuantity | None = Field(
@@ -76,7 +76,7 @@ DEFAULT_CONTACT = ContactSpec(
 class FrictionSpec(Strict):
     """Tangential friction law; the parameters a law needs are checked after merging with defaults."""
 
-    law: Literal["none", "coulomb", "stiction_step", "ambrosio"] | None = None
+    law: Literal["none", "coulomb", "stiction_step", "ambrosio"] | None = Field(None, description="friction law; a layer that changes it starts that law afresh")
     mu_s: float | None = Field(None, ge=0.0, description="static friction coefficient (stiction_step)")
     mu_d: float | None = Field(None, ge=0.0, description="dynamic friction coefficient (all laws)")
     v_s: Speed | None = Field(None, gt=0.0, description="stiction transition speed (stiction_step)")
@@ -104,13 +104,13 @@ class Defaults(Strict):
 
 
 class Body(Strict):
-    name: str
-    mass: Mass = Field(gt=0.0)
+    name: str = Field(description="unique body name; `ground` is reserved")
+    mass: Mass = Field(gt=0.0, description="mass m")
     inertia: Inertia = Field(gt=0.0, description="moment of inertia about the centre of mass")
     position: Point = Field(description="centre of mass at t = 0 (global); a guess refined by assembly")
-    angle: Angle = 0.0
-    velocity: tuple[Speed, Speed] = (0.0, 0.0)
-    angular_velocity: AngularSpeed = 0.0
+    angle: Angle = Field(0.0, description="orientation at t = 0, counter-clockwise from the global x axis")
+    velocity: tuple[Speed, Speed] = Field((0.0, 0.0), description="centre-of-mass velocity at t = 0 (made consistent by assembly)")
+    angular_velocity: AngularSpeed = Field(0.0, description="angular velocity at t = 0 (made consistent by assembly)")
     points: dict[str, Point] = Field(default_factory=dict, description="body-fixed points, body frame, from the centre of mass")
 
 
@@ -120,14 +120,14 @@ class Body(Strict):
 class RevoluteJoint(Strict):
     """Pin joint; with `clearance` > 0 it is a clearance joint (first body bearing, second journal)."""
 
-    name: str
-    type: Literal["revolute"]
-    bodies: tuple[str, str]
+    name: str = Field(description="unique joint name")
+    type: Literal["revolute"] = Field(description="joint kind")
+    bodies: tuple[str, str] = Field(description="[bearing, journal]: the two bodies; for a clearance joint the first is the bearing")
     at: PointRef | None = Field(None, description="a named global point or [x, y] at t = 0")
     points: tuple[str, str] | None = Field(None, description="named body points [on first, on second]")
     clearance: Length | None = Field(None, ge=0.0, description="radial clearance c = R_B - R_J; 0 or absent: ideal")
-    bearing_radius: Length | None = Field(None, gt=0.0)
-    journal_radius: Length | None = Field(None, gt=0.0)
+    bearing_radius: Length | None = Field(None, gt=0.0, description="bearing radius R_B; default defaults.bearing_radius")
+    journal_radius: Length | None = Field(None, gt=0.0, description="journal radius R_J; with it and no clearance, c = R_B − R_J")
     material: Material | None = None
     contact: ContactSpec | None = None
     friction: FrictionSpec | None = None
@@ -139,11 +139,11 @@ class RevoluteJoint(Strict):
 class PrismaticJoint(Strict):
     """Translational guide: the second body slides along `axis` of the first, without relative rotation."""
 
-    name: str
-    type: Literal["prismatic"]
-    bodies: tuple[str, str]
+    name: str = Field(description="unique joint name")
+    type: Literal["prismatic"] = Field(description="joint kind")
+    bodies: tuple[str, str] = Field(description="[guide, slider]: the second slides along the first")
     at: PointRef | None = Field(None, description="a point on the guide line (named or [x, y]) at t = 0")
-    points: tuple[str, str] | None = None
+    points: tuple[str, str] | None = Field(None, description="named body points [on first, on second] on the guide line")
     axis: Direction = Field(description="guide direction, global frame at t = 0")
 
     _unit_axis = field_validator("axis")(_unit_vector)
@@ -158,33 +158,33 @@ Joint = Annotated[Union[RevoluteJoint, PrismaticJoint], Field(discriminator="typ
 class StrokeMotion(Strict):
     """Meng 2015 eq. 16 generalised: s(t) = S τ²(3 − 2τ), τ = (t − t0)/T, held at S after."""
 
-    law: Literal["stroke"]
-    stroke: RawQuantity
-    duration: Time = Field(gt=0.0)
-    start: Time = 0.0
+    law: Literal["stroke"] = Field(description="motion law")
+    stroke: RawQuantity = Field(description="total stroke S: length (m) or angle (rad) by the driven coordinate")
+    duration: Time = Field(gt=0.0, description="stroke time T")
+    start: Time = Field(0.0, description="time t0 at which the stroke begins")
 
 
 class ConstantSpeedMotion(Strict):
-    law: Literal["constant_speed"]
-    speed: RawQuantity
+    law: Literal["constant_speed"] = Field(description="motion law")
+    speed: RawQuantity = Field(description="constant rate: m/s or rad/s by the driven coordinate")
 
 
 class PolynomialMotion(Strict):
     """s(t) = Σ_k c_k t^k, k = 1, 2, …, in SI units of the driven coordinate."""
 
-    law: Literal["polynomial"]
-    coefficients: list[float] = Field(min_length=1)
+    law: Literal["polynomial"] = Field(description="motion law")
+    coefficients: list[float] = Field(min_length=1, description="[c_1, c_2, …] of s = Σ c_k t^k, SI, at most 7")
 
 
 class TableMotion(Strict):
     """s(t) from a CSV file (cubic spline through the samples, value held after the last)."""
 
-    law: Literal["table"]
-    file: str
-    time_column: Union[str, int] = 0
-    value_column: Union[str, int] = 1
-    time_unit: str = "s"
-    value_unit: str | None = None
+    law: Literal["table"] = Field(description="motion law")
+    file: str = Field(description="CSV file, relative to the YAML file")
+    time_column: Union[str, int] = Field(0, description="header name or 0-based index of the time column")
+    value_column: Union[str, int] = Field(1, description="header name or 0-based index of the value column")
+    time_unit: str = Field("s", description="unit of the time column")
+    value_unit: str | None = Field(None, description="unit of the value column; default m or rad by the driven coordinate")
 
 
 Motion = Annotated[
@@ -195,10 +195,10 @@ Motion = Annotated[
 class Driver(Strict):
     """Prescribed motion of a joint's relative coordinate or of a body coordinate, from its t = 0 value."""
 
-    name: str
-    joint: str | None = None
-    body: str | None = None
-    coordinate: Literal["x", "y", "angle"] | None = None
+    name: str = Field(description="unique driver name")
+    joint: str | None = Field(None, description="ideal revolute or prismatic joint whose relative coordinate is driven")
+    body: str | None = Field(None, description="body whose coordinate is driven (with coordinate:)")
+    coordinate: Literal["x", "y", "angle"] | None = Field(None, description="driven body coordinate: centre-of-mass x, y, or angle")
     motion: Motion
 
     @model_validator(mode="after")
@@ -214,39 +214,39 @@ class Driver(Strict):
 
 
 class ConstantForce(Strict):
-    type: Literal["constant"]
-    name: str
-    body: str
-    point: PointRef | None = None
-    force: tuple[Force, Force] = (0.0, 0.0)
-    torque: Torque = 0.0
+    type: Literal["constant"] = Field(description="force kind")
+    name: str = Field(description="unique force name")
+    body: str = Field(description="loaded body")
+    point: PointRef | None = Field(None, description="point of application: global point at t = 0, fixed to the body; default centre of mass")
+    force: tuple[Force, Force] = Field((0.0, 0.0), description="[F_x, F_y], global frame")
+    torque: Torque = Field(0.0, description="torque, counter-clockwise positive")
 
 
 class SpringDamper(Strict):
     """Linear spring-damper between two points: F = k (ℓ − ℓ0) + c ℓ̇ + preload, along the line."""
 
-    type: Literal["spring_damper"]
-    name: str
-    bodies: tuple[str, str]
-    at: tuple[PointRef, PointRef] | None = None
-    points: tuple[str, str] | None = None
-    stiffness: SpringStiffness = 0.0
-    damping: Damping = 0.0
+    type: Literal["spring_damper"] = Field(description="force kind")
+    name: str = Field(description="unique force name")
+    bodies: tuple[str, str] = Field(description="the two connected bodies")
+    at: tuple[PointRef, PointRef] | None = Field(None, description="the two ends as global points at t = 0; default the centres of mass")
+    points: tuple[str, str] | None = Field(None, description="the two ends as named body points")
+    stiffness: SpringStiffness = Field(0.0, description="spring rate k")
+    damping: Damping = Field(0.0, description="damping coefficient c")
     free_length: Length | None = Field(None, description="ℓ0; default: the length at t = 0")
-    preload: Force = 0.0
+    preload: Force = Field(0.0, description="constant tension added to the spring force")
 
 
 class TabulatedForce(Strict):
-    type: Literal["tabulated"]
-    name: str
-    body: str
-    point: PointRef | None = None
-    direction: Direction
-    file: str
-    time_column: Union[str, int] = 0
-    value_column: Union[str, int] = 1
-    time_unit: str = "s"
-    value_unit: str = "N"
+    type: Literal["tabulated"] = Field(description="force kind")
+    name: str = Field(description="unique force name")
+    body: str = Field(description="loaded body")
+    point: PointRef | None = Field(None, description="point of application: global point at t = 0, fixed to the body; default centre of mass")
+    direction: Direction = Field(description="direction of the force, global frame, normalised")
+    file: str = Field(description="CSV file, relative to the YAML file")
+    time_column: Union[str, int] = Field(0, description="header name or 0-based index of the time column")
+    value_column: Union[str, int] = Field(1, description="header name or 0-based index of the force column")
+    time_unit: str = Field("s", description="unit of the time column")
+    value_unit: str = Field("N", description="unit of the force column")
 
     _unit_direction = field_validator("direction")(_unit_vector)
 
@@ -260,26 +260,26 @@ AppliedForce = Annotated[Union[ConstantForce, SpringDamper, TabulatedForce], Fie
 class PointSensor(Strict):
     """A body point's displacement (from t = 0), velocity or acceleration along a global direction."""
 
-    name: str
-    type: Literal["point_displacement", "point_velocity", "point_acceleration"]
-    body: str
-    point: PointRef | None = None
-    direction: Direction
+    name: str = Field(description="unique sensor name (the result path /sensors/<name>)")
+    type: Literal["point_displacement", "point_velocity", "point_acceleration"] = Field(description="quantity measured")
+    body: str = Field(description="measured body")
+    point: PointRef | None = Field(None, description="measured point: global point at t = 0, fixed to the body; default centre of mass")
+    direction: Direction = Field(description="global direction the value is projected on, normalised")
 
     _unit_direction = field_validator("direction")(_unit_vector)
 
 
 class BodySensor(Strict):
-    name: str
-    type: Literal["body_angle", "body_angular_velocity", "body_angular_acceleration"]
-    body: str
+    name: str = Field(description="unique sensor name (the result path /sensors/<name>)")
+    type: Literal["body_angle", "body_angular_velocity", "body_angular_acceleration"] = Field(description="quantity measured")
+    body: str = Field(description="measured body")
 
 
 class JointForceSensor(Strict):
-    name: str
-    type: Literal["joint_force"]
-    joint: str
-    component: Literal["x", "y", "magnitude", "normal", "friction"] = "magnitude"
+    name: str = Field(description="unique sensor name (the result path /sensors/<name>)")
+    type: Literal["joint_force"] = Field(description="quantity measured")
+    joint: str = Field(description="joint whose force is measured")
+    component: Literal["x", "y", "magnitude", "normal", "friction"] = Field("magnitude", description="x, y or magnitude of the force on the second body; normal F_n; friction F_t (ideal joint: reaction magnitude, 0)")
 
 
 Sensor = Annotated[Union[PointSensor, BodySensor, JointForceSensor], Field(discriminator="type")]
@@ -288,22 +288,22 @@ Sensor = Annotated[Union[PointSensor, BodySensor, JointForceSensor], Field(discr
 class OutputSensors(Strict):
     """Which sensors are 'the output' in summaries (the moving contact of a breaker)."""
 
-    displacement: str | None = None
-    velocity: str | None = None
-    acceleration: str | None = None
+    displacement: str | None = Field(None, description="name of the point_displacement sensor that is the output")
+    velocity: str | None = Field(None, description="name of the point_velocity sensor that is the output")
+    acceleration: str | None = Field(None, description="name of the point_acceleration sensor that is the output")
 
 
 # --- solver ---------------------------------------------------------------------------------------
 
 
 class SolverSettings(Strict):
-    t_end: Time = Field(gt=0.0)
+    t_end: Time = Field(gt=0.0, description="end time of the simulation")
     output_rate: Frequency = Field(1e5, gt=0.0, description="samples per second of the written histories")
-    rtol: float = Field(1e-7, gt=0.0, lt=1.0)
+    rtol: float = Field(1e-7, gt=0.0, lt=1.0, description="relative error tolerance per step")
     atol: float = Field(1e-10, gt=0.0, description="absolute tolerance on positions (m, rad) and velocities")
-    max_step: Time = Field(1e-3, gt=0.0)
-    min_step: Time = Field(1e-12, gt=0.0)
-    initial_step: Time | None = Field(None, gt=0.0)
+    max_step: Time = Field(1e-3, gt=0.0, description="largest step")
+    min_step: Time = Field(1e-12, gt=0.0, description="smallest step (a rejected step at min_step stops the run)")
+    initial_step: Time | None = Field(None, gt=0.0, description="first step size; default chosen by the solver")
 
     @model_validator(mode="after")
     def _steps_ordered(self):
@@ -318,9 +318,9 @@ class SolverSettings(Strict):
 class Mechanism(Strict):
     """A planar mechanism: what the YAML file says, validated, in SI units."""
 
-    name: str = "mechanism"
-    description: str | None = None
-    gravity: tuple[Acceleration, Acceleration] = (0.0, 0.0)
+    name: str = Field("mechanism", description="title of the mechanism, shown in summaries and result files")
+    description: str | None = Field(None, description="free text about the model")
+    gravity: tuple[Acceleration, Acceleration] = Field((0.0, 0.0), description="gravitational acceleration [g_x, g_y], global frame; default no gravity")
     defaults: Defaults = Defaults()
     points: dict[str, Point] = Field(default_factory=dict, description="named global points at t = 0")
     bodies: list[Body] = Field(min_length=1)

@@ -16,7 +16,7 @@ import numpy as np
 from clearsim.assembly.build import BuildError
 from clearsim.assembly.system import System, assemble
 from clearsim.errors import InputError, SolverError
-from clearsim.io.hdf5 import ResultWriter, keep_existing, read_result
+from clearsim.io.hdf5 import ResultWriter, group_attribute, keep_existing, read_result
 from clearsim.model.loader import LoadedMechanism, load_mechanism
 from clearsim.solver.outputs import classify_episodes, chunk_outputs, sample_modes
 from clearsim.solver.simulate import Run
@@ -127,12 +127,18 @@ def summarize(path: Path) -> Summary:
         key = f"sensors/{name}"
         peak[role] = (name, float(np.max(np.abs(data[key])))) if name and key in data and len(data[key]) else None
     joints = [j for j in str(data["attrs"].get("clearance_joints", "")).split(",") if j]
-    forces = {j: float(np.max(data[f"joints/{j}/normal_force"], initial=0.0)) for j in joints}
+    forces = {j: _peak_contact_force(path, j, data[f"joints/{j}/normal_force"]) for j in joints}
     shares = {}
     for j in joints:
         mode = data[f"joints/{j}/mode"]
         shares[j] = tuple(float(np.mean(mode == m)) if len(mode) else 0.0 for m in (0, 1, 2))
     return Summary(peak["velocity"], peak["acceleration"], forces, shares)
+
+
+def _peak_contact_force(path: Path, joint: str, sampled: np.ndarray) -> float:
+    """The larger of the sampled peak and the peak over all step ends (which samples can miss)."""
+    tracked = group_attribute(path, f"joints/{joint}/episodes", "peak_normal_force_N", 0.0)
+    return max(float(tracked), float(np.max(sampled, initial=0.0)))
 
 
 def _output_sensors(config_yaml: str) -> dict:

@@ -115,3 +115,10 @@ def read_result(path: Path) -> dict:
         out = {"attrs": dict(handle.attrs)}
         handle.visititems(lambda name, node: out.__setitem__(name, node[()]) if isinstance(node, h5py.Dataset) else None)
         return out
+
+
+def group_attribute(path: Path, group: str, name: str, default=None):
+    """One attribute of a group of a result file, or `default` when the group or attribute is absent."""
+    with h5py.File(path, "r") as handle:
+        node = handle.get(group)
+        return node.attrs.get(name, default) if node is not None else default

@@ -72,45 +72,112 @@ def evaluate_constraints(system, t, q, phi):
 
 
 @njit(cache=True)
-def _set(jac, row, body, column, value):
-    if body >= 0:
-        jac[row, 3 * body + column] += value
+def evaluate_jacobian_blocks(system, q, blocks, bodies):
+    """Φ_q in row blocks: blocks[r, s, :] = ∂Φ_r/∂q_b for the row's two bodies b = bodies[r, s] (−1: ground).
 
-
-@njit(cache=True)
-def evaluate_jacobian(system, q, jac):
-    """Φ_q into jac (zeroed here)."""
-    jac[:, :] = 0.0
+    Every row touches at most two bodies, so products with Φ_q cost O(rows), not O(rows × coordinates).
+    """
+    blocks[:, :, :] = 0.0
     row = 0
     for k in range(system.pin_bodies.shape[0]):
         bi = system.pin_bodies[k, 0]
         bj = system.pin_bodies[k, 1]
         aix, aiy, ajx, ajy = _arms(q, bi, bj, system.pin_points[k])
         for axis in range(2):
-            _set(jac, row + axis, bi, axis, 1.0)
-            _set(jac, row + axis, bj, axis, -1.0)
-        _set(jac, row, bi, 2, -aiy)
-        _set(jac, row + 1, bi, 2, aix)
-        _set(jac, row, bj, 2, ajy)
-        _set(jac, row + 1, bj, 2, -ajx)
+            blocks[row + axis, 0, axis] = 1.0
+            blocks[row + axis, 1, axis] = -1.0
+            bodies[row + axis, 0], bodies[row + axis, 1] = bi, bj
+        blocks[row, 0, 2] = -aiy
+        blocks[row + 1, 0, 2] = aix
+        blocks[row, 1, 2] = ajy
+        blocks[row + 1, 1, 2] = -ajx
         row += 2
     for k in range(system.offset_bodies.shape[0]):
         bi = system.offset_bodies[k, 0]
         bj = system.offset_bodies[k, 1]
         wx, wy, dx, dy = _offset_terms(system, k, q)
         aix, aiy, ajx, ajy = _arms(q, bi, bj, system.offset_params[k])
-        _set(jac, row, bi, 0, -wx)
-        _set(jac, row, bi, 1, -wy)
-        _set(jac, row, bj, 0, wx)
-        _set(jac, row, bj, 1, wy)
+        bodies[row, 0], bodies[row, 1] = bi, bj
+        blocks[row, 0, 0] = -wx
+        blocks[row, 0, 1] = -wy
+        blocks[row, 1, 0] = wx
+        blocks[row, 1, 1] = wy
         # ∂/∂θ_i: (B_i w̄)·d − w·(B_i s_i), with B v = rot90(A v)
-        _set(jac, row, bi, 2, (-wy * dx + wx * dy) - (wx * -aiy + wy * aix))
-        _set(jac, row, bj, 2, wx * -ajy + wy * ajx)
+        blocks[row, 0, 2] = (-wy * dx + wx * dy) - (wx * -aiy + wy * aix)
+        blocks[row, 1, 2] = wx * -ajy + wy * ajx
         row += 1
     for k in range(system.angle_bodies.shape[0]):
-        _set(jac, row, system.angle_bodies[k, 0], 2, -1.0)
-        _set(jac, row, system.angle_bodies[k, 1], 2, 1.0)
+        blocks[row, 0, 2] = -1.0
+        blocks[row, 1, 2] = 1.0
+        bodies[row, 0], bodies[row, 1] = system.angle_bodies[k, 0], system.angle_bodies[k, 1]
         row += 1
+
+
+@njit(cache=True)
+def jacobian_blocks(system, q):
+    """(blocks, bodies) of Φ_q at q."""
+    m = constraint_count(system)
+    blocks = np.empty((m, 2, 3))
+    bodies = np.empty((m, 2), np.int64)
+    evaluate_jacobian_blocks(system, q, blocks, bodies)
+    return blocks, bodies
+
+
+@njit(cache=True)
+def evaluate_jacobian(system, q, jac):
+    """Φ_q as a dense matrix (assembly checks and tests; the solver works on the blocks)."""
+    jac[:, :] = 0.0
+    blocks, bodies = jacobian_blocks(system, q)
+    for row in range(blocks.shape[0]):
+        for slot in range(2):
+            if bodies[row, slot] >= 0:
+                jac[row, 3 * bodies[row, slot]:3 * bodies[row, slot] + 3] += blocks[row, slot]
+
+
+@njit(cache=True)
+def jacobian_times(blocks, bodies, x):
+    """Φ_q x."""
+    out = np.zeros(blocks.shape[0])
+    for row in range(blocks.shape[0]):
+        for slot in range(2):
+            b = bodies[row, slot]
+            if b >= 0:
+                out[row] += blocks[row, slot, 0] * x[3 * b] + blocks[row, slot, 1] * x[3 * b + 1] + blocks[row, slot, 2] * x[3 * b + 2]
+    return out
+
+
+@njit(cache=True)
+def jacobian_transpose_times(blocks, bodies, lam, n):
+    """Φ_qᵀ λ (length n)."""
+    out = np.zeros(n)
+    for row in range(blocks.shape[0]):
+        for slot in range(2):
+            b = bodies[row, slot]
+            if b >= 0:
+                for c in range(3):
+                    out[3 * b + c] += blocks[row, slot, c] * lam[row]
+    return out
+
+
+@njit(cache=True)
+def schur_complement(blocks, bodies, minv):
+    """S = Φ_q M⁻¹ Φ_qᵀ from the blocks: rows couple only through a shared body."""
+    m = blocks.shape[0]
+    schur = np.zeros((m, m))
+    for i in range(m):
+        for j in range(i + 1):
+            total = 0.0
+            for si in range(2):
+                b = bodies[i, si]
+                if b < 0:
+                    continue
+                for sj in range(2):
+                    if bodies[j, sj] == b:
+                        for c in range(3):
+                            total += blocks[i, si, c] * minv[3 * b + c] * blocks[j, sj, c]
+            schur[i, j] = total
+            schur[j, i] = total
+    return schur
 
 
 @njit(cache=True)

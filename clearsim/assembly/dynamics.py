@@ -16,8 +16,8 @@ import numpy as np
 from numba import njit
 
 from clearsim.assembly.constraints import (
-    constraint_count, evaluate_acceleration_rhs, evaluate_constraints, evaluate_jacobian,
-    evaluate_velocity_rhs, prescribed,
+    constraint_count, evaluate_acceleration_rhs, evaluate_constraints, evaluate_velocity_rhs, jacobian_blocks,
+    jacobian_times, jacobian_transpose_times, prescribed, schur_complement,
 )
 from clearsim.assembly.forces import (
     add_applied_forces, add_clearance_forces, add_global_force, clearance_kinematics,
@@ -79,11 +79,17 @@ def cholesky_solve(matrix, rhs):
 
 
 @njit(cache=True)
-def constrained_response(jac, minv, force, gamma):
+def constrained_response(blocks, bodies, minv, force, gamma):
     """(a, λ) with a = M⁻¹ (f − Φ_qᵀ λ) and Φ_q a = γ."""
-    weighted = jac * minv  # Φ_q M⁻¹ (column scaling)
-    lam = cholesky_solve(weighted @ jac.T, weighted @ force - gamma)
-    return minv * (force - jac.T @ lam), lam
+    lam = cholesky_solve(schur_complement(blocks, bodies, minv), jacobian_times(blocks, bodies, minv * force) - gamma)
+    return minv * (force - jacobian_transpose_times(blocks, bodies, lam, force.shape[0])), lam
+
+
+@njit(cache=True)
+def minimum_norm_correction(blocks, bodies, minv, residual, n):
+    """M⁻¹Φ_qᵀ S⁻¹ r: the smallest change (in the M metric) that removes a constraint residual r."""
+    lam = cholesky_solve(schur_complement(blocks, bodies, minv), residual)
+    return minv * jacobian_transpose_times(blocks, bodies, lam, n)
 
 
 @njit(cache=True)
@@ -94,11 +100,10 @@ def accelerations(system, t, q, qd, generalized):
     minv = inverse_mass(system)
     if m == 0:
         return minv * generalized, np.zeros(0)
-    jac = np.empty((m, n))
-    evaluate_jacobian(system, q, jac)
+    blocks, bodies = jacobian_blocks(system, q)
     gamma = np.empty(m)
     evaluate_acceleration_rhs(system, t, q, qd, gamma)
-    return constrained_response(jac, minv, generalized, gamma)
+    return constrained_response(blocks, bodies, minv, generalized, gamma)
 
 
 @njit(cache=True)
@@ -150,15 +155,12 @@ def project_positions(system, t, q, tolerance, max_iterations):
     n = q.shape[0]
     minv = inverse_mass(system)
     phi = np.empty(m)
-    jac = np.empty((m, n))
     for _ in range(max_iterations):
         evaluate_constraints(system, t, q, phi)
         if np.max(np.abs(phi)) <= tolerance:
             break
-        evaluate_jacobian(system, q, jac)
-        weighted = jac * minv
-        correction = cholesky_solve(weighted @ jac.T, phi)
-        q -= minv * (jac.T @ correction)
+        blocks, bodies = jacobian_blocks(system, q)
+        q -= minimum_norm_correction(blocks, bodies, minv, phi, n)
     evaluate_constraints(system, t, q, phi)
     return np.max(np.abs(phi))
 
@@ -169,14 +171,10 @@ def project_velocities(system, t, q, qd):
     m = constraint_count(system)
     if m == 0:
         return
-    n = q.shape[0]
-    jac = np.empty((m, n))
-    evaluate_jacobian(system, q, jac)
+    blocks, bodies = jacobian_blocks(system, q)
     nu = np.empty(m)
     evaluate_velocity_rhs(system, t, nu)
-    weighted = jac * inverse_mass(system)
-    correction = cholesky_solve(weighted @ jac.T, jac @ qd - nu)
-    qd -= inverse_mass(system) * (jac.T @ correction)
+    qd -= minimum_norm_correction(blocks, bodies, inverse_mass(system), jacobian_times(blocks, bodies, qd) - nu, q.shape[0])
 
 
 @njit(cache=True)
@@ -206,8 +204,7 @@ def effective_mass(system, k, q):
     if m == 0:
         response = minv * pair
     else:
-        jac = np.empty((m, n))
-        evaluate_jacobian(system, q, jac)
-        response = constrained_response(jac, minv, pair, np.zeros(m))[0]
+        blocks, bodies = jacobian_blocks(system, q)
+        response = constrained_response(blocks, bodies, minv, pair, np.zeros(m))[0]
     mobility = pair @ response
     return 1.0 / mobility if mobility > 0.0 else np.inf

@@ -128,6 +128,52 @@ def run(
 
 @app.command()
 @user_errors
+def sweep(
+    config: Optional[Path] = ConfigArgument,
+    clearance: Optional[str] = typer.Option(
+        None, "--clearance", help="Clearances to sweep, mm unless a unit is written: 0.01,0.03,0.1 "
+        "(every clearance joint of the file, or the --joints)."),
+    joints: Optional[str] = typer.Option(
+        None, "--joints", help="The revolute joints --clearance applies to: A,J (an ideal one becomes a clearance joint)."),
+    overrides: List[str] = typer.Option(
+        [], "--set", help="path=value for every case, or path=v1,v2,... to sweep (repeatable; lists form a grid)."),
+    sample: Optional[int] = typer.Option(None, "--sample", help="Monte Carlo: N cases drawn from the file's tolerances."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the Monte Carlo draws."),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes (default: all cores)."),
+    scheduler: Optional[str] = typer.Option(
+        None, "--scheduler", help="Run on an existing Dask cluster: tcp://host:8786 (shared file system)."),
+    out: Optional[Path] = typer.Option(
+        None, "-o", "--out", help="Sweep folder (default: results/sweep-<config>-<hash>/); re-running resumes."),
+    no_ideal: bool = typer.Option(False, "--no-ideal", help="Leave out the ideal (no-clearance) reference case."),
+    delay_fraction: float = typer.Option(
+        0.5, "--delay-fraction", help="Start delay: when the output velocity reaches this fraction of the ideal peak."),
+    retry_failed: bool = typer.Option(False, "--retry-failed", help="Run cases that failed before again."),
+) -> None:
+    """Run a parameter study: one run per case, in parallel, with a summary table and summary.csv."""
+    from clearsim.runner import BUNDLED_CONFIG
+    from clearsim.sweep import DaskCluster, LocalPool, SweepFailed, SweepInterrupted, SweepRequest, plan_sweep, run_sweep
+    from clearsim.sweep import display
+
+    request = SweepRequest(config, overrides, clearance, joints, sample, seed, not no_ideal, out, delay_fraction)
+    plan = plan_sweep(request, BUNDLED_CONFIG)
+    executor = DaskCluster(scheduler, workers) if scheduler else LocalPool(workers)
+    console.print(display.opening_line(plan, executor.describe()), soft_wrap=True)
+    progress, update = display.case_progress(errors, len(plan.cases))
+    try:
+        with progress:
+            result = run_sweep(plan, executor, update, retry_failed)
+    except SweepInterrupted as exc:
+        console.print(display.summary_table(exc.result))
+        console.print("\n".join(display.closing_lines(exc.result)), soft_wrap=True)
+        raise
+    console.print(display.summary_table(result))
+    console.print("\n".join(display.closing_lines(result)), soft_wrap=True)
+    if result.failed:
+        raise SweepFailed(display.failure_message(result))
+
+
+@app.command()
+@user_errors
 def validate(config: Optional[Path] = ConfigArgument, overrides: List[str] = SetOption) -> None:
     """Check a mechanism file (schema, names, units, assembly) without running it."""
     from clearsim.runner import BUNDLED_CONFIG, prepare
@@ -148,6 +194,49 @@ def schema() -> None:
     from clearsim.model.schema import Mechanism
 
     sys.stdout.write(json.dumps(Mechanism.model_json_schema(), indent=2) + "\n")
+
+
+@app.command()
+@user_errors
+def plot(
+    inputs: List[Path] = typer.Argument(..., help="Result files (overlaid when several) or one sweep folder."),
+    out: Optional[Path] = typer.Option(None, "-o", "--out", help="Folder for the figures (default: the input's folder)."),
+    fmt: str = typer.Option("png", "--format", help="png, svg or pdf."),
+    sensors: List[str] = typer.Option([], "--sensor", help="Sensor to plot instead of the output sensors (repeatable)."),
+    time_window: Optional[str] = typer.Option(None, "--time-window", help="Zoom: start:end in ms, e.g. 10:20."),
+    measured: Optional[Path] = typer.Option(None, "--measured", help="Measurement CSV to plot the simulation over."),
+    animate: bool = typer.Option(False, "--animate", help="Also write the mechanism moving (GIF)."),
+    exaggerate: Optional[str] = typer.Option(
+        None, "--exaggerate", help="Animation: magnify journal offsets by this factor, or 'auto'."),
+    show: bool = typer.Option(False, "--show", help="Also open the figures in a window (where a display exists)."),
+) -> None:
+    """Write the figure set of result files or a sweep folder (paths printed)."""
+    from clearsim.plot import PlotRequest, plot_results
+
+    report = plot_results(PlotRequest(inputs, out, fmt, sensors, time_window, measured, animate, exaggerate, show))
+    for note in report.notes:
+        errors.print(f"note: {escape(note)}", highlight=False, soft_wrap=True)
+    for path in report.written:
+        console.print(str(path), highlight=False, soft_wrap=True)
+
+
+@app.command()
+@user_errors
+def draw(
+    config: Optional[Path] = ConfigArgument,
+    out: Optional[Path] = typer.Option(None, "-o", "--output", help="Figure file (default: results/<config>-drawing.png)."),
+    overrides: List[str] = SetOption,
+    fmt: Optional[str] = typer.Option(None, "--format", help="png, svg or pdf (default: from the -o suffix, else png)."),
+    show: bool = typer.Option(False, "--show", help="Also open the figure in a window."),
+) -> None:
+    """Draw the mechanism as assembled at t = 0, with the names of its bodies and joints."""
+    from clearsim.plot import draw_config
+    from clearsim.runner import BUNDLED_CONFIG
+
+    path, notes = draw_config(config or BUNDLED_CONFIG, overrides, out, fmt, show)
+    for note in notes:
+        errors.print(f"note: {escape(note)}", highlight=False, soft_wrap=True)
+    console.print(str(path), highlight=False, soft_wrap=True)
 
 
 if __name__ == "__main__":

@@ -27,6 +27,8 @@ from clearsim.units import (
     SpringStiffness,
     Time,
     Torque,
+    UnitError,
+    parse_quantity,
 )
 
 RawQuantity = Union[float, str]  # converted where its kind is known (a driver's stroke: m or rad)
@@ -312,6 +314,50 @@ class SolverSettings(Strict):
         return self
 
 
+# --- tolerances (Monte Carlo sweeps) --------------------------------------------------------------
+
+
+def _quantity(value: RawQuantity, what: str):
+    try:
+        return parse_quantity(value)
+    except UnitError as exc:
+        raise ValueError(f"{what}: {exc}") from None
+
+
+class Tolerance(Strict):
+    """A value drawn at random for each case of `clearsim sweep --sample N` (docs/sweeps.md).
+
+    The bounds and moments take the unit of the value at `path` ('0.01 mm', or a bare number
+    for a dimensionless value such as mu_d); the drawn value is applied as `--set path=value`.
+    """
+
+    path: str = Field(description="the `--set` path of the value, e.g. joints.A.clearance")
+    distribution: Literal["uniform", "normal"] = Field(description="uniform between low and high, or normal with mean and std")
+    low: RawQuantity | None = Field(None, description="uniform: lower bound; normal: optional lower truncation bound")
+    high: RawQuantity | None = Field(None, description="uniform: upper bound; normal: optional upper truncation bound")
+    mean: RawQuantity | None = Field(None, description="normal: mean value")
+    std: RawQuantity | None = Field(None, description="normal: standard deviation, > 0")
+
+    @model_validator(mode="after")
+    def _parameters_fit(self):
+        needed = ("low", "high") if self.distribution == "uniform" else ("mean", "std")
+        missing = [key for key in needed if getattr(self, key) is None]
+        if missing:
+            raise ValueError(f"a {self.distribution} distribution needs {' and '.join(missing)}")
+        if self.distribution == "uniform" and (self.mean is not None or self.std is not None):
+            raise ValueError("a uniform distribution takes low and high, not mean or std")
+        given = {key: _quantity(getattr(self, key), key) for key in ("low", "high", "mean", "std")
+                 if getattr(self, key) is not None}
+        first = next(iter(given.values()))
+        if any(q.dimensionality != first.dimensionality for q in given.values()):
+            raise ValueError(f"{' and '.join(given)} must have units of the same kind")
+        if "low" in given and "high" in given and not given["low"] < given["high"]:
+            raise ValueError("low must be smaller than high")
+        if "std" in given and not given["std"].magnitude > 0:
+            raise ValueError("std must be greater than 0")
+        return self
+
+
 # --- the file -------------------------------------------------------------------------------------
 
 
@@ -330,6 +376,8 @@ class Mechanism(Strict):
     sensors: list[Sensor] = Field(default_factory=list)
     output: OutputSensors = OutputSensors()
     solver: SolverSettings
+    tolerances: list[Tolerance] = Field(
+        default_factory=list, description="random distributions of values for `clearsim sweep --sample N`; ignored by `run`")
 
     def body(self, name: str) -> Body:
         return next(b for b in self.bodies if b.name == name)

@@ -1,0 +1,156 @@
+"""`clearsim plot`: the figure set of one run, several runs overlaid, or a sweep folder.
+
+Everything is read and every figure is built before anything is written, so a bad input
+leaves no half-written set behind. File names are stable (docs/plotting.md):
+
+    <stem>-output.png      output sensors (or the --sensor ones) against time
+    <stem>-joint-<J>.png   clearance joint J: journal path, contact forces, penetration
+    <stem>-spectrum.png    amplitude spectrum of the output acceleration (or the --sensor ones)
+    <stem>-energy.png      energy balance and constraint violation
+    <stem>-measured.png    simulation over measurement, residual below (--measured)
+    <stem>-merit.png       sweep folders with summary.csv: figures of merit against the swept quantity
+    <stem>-animation.gif   the mechanism moving (--animate), one per run
+
+<stem> is the file's name for one file, `compare` for several files, `sweep` for a folder.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from clearsim.plot import history, journal, measured as measured_plots, sweep
+from clearsim.plot.animate import animate_run, check_animation, parse_exaggerate
+from clearsim.plot.data import PlotInputError, RunData, apply_window, load_run, parse_time_window, signals
+from clearsim.plot.labels import run_labels
+from clearsim.plot.style import DPI, FORMATS, show_all
+
+
+
+@dataclass
+class PlotRequest:
+    inputs: list  # result files, or one sweep folder
+    out: Path | None = None  # default: the folder of the (first) input
+    fmt: str = "png"
+    sensors: list = field(default_factory=list)
+    time_window: str | None = None  # "a:b", ms unless a unit is written
+    measured: Path | None = None
+    animate: bool = False
+    exaggerate: str | None = None  # journal-offset magnification in the animation: a factor or "auto"
+    show: bool = False
+
+
+@dataclass
+class PlotReport:
+    written: list
+    notes: list
+
+
+@dataclass
+class _Inputs:
+    files: list
+    stem: str
+    folder: Path | None  # a sweep folder
+
+
+def _inputs(paths: list) -> _Inputs:
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise PlotInputError("give at least one result file (.h5) or a sweep folder")
+    folders = [p for p in paths if p.is_dir()]
+    if folders and len(paths) > 1:
+        raise PlotInputError(f"{folders[0]} is a folder: give either result files or one sweep folder")
+    if folders:
+        return _Inputs(sweep.result_files(folders[0]), "sweep", folders[0])
+    return _Inputs(paths, paths[0].stem if len(paths) == 1 else "compare", None)
+
+
+def _load(inputs: _Inputs, request: PlotRequest) -> list[RunData]:
+    window = parse_time_window(request.time_window)
+    runs = [load_run(path) for path in inputs.files]
+    labels = run_labels(runs) if len(runs) > 1 else [""] * len(runs)
+    for index, (run, label) in enumerate(zip(runs, labels)):
+        apply_window(run, window)
+        run.label, run.index = label, index
+    return runs
+
+
+def _spectrum_sensors(runs: list[RunData], chosen: list) -> list:
+    if chosen:
+        return list(chosen)
+    acceleration = runs[0].output.get("acceleration")
+    return [acceleration] if acceleration else []
+
+
+def _clearance_joints(runs: list[RunData]) -> list:
+    return list(dict.fromkeys(j for run in runs for j in run.clearance_joints))
+
+
+def _signals_figure(runs: list[RunData], chosen: list, figures: dict, notes: list, show: bool) -> None:
+    shown = signals(runs[0], chosen)
+    for run in runs[1:]:
+        signals(run, shown)  # every overlaid run must have them
+    if shown:
+        figures["output"] = history.signals_figure(runs, shown, show)
+    else:
+        notes.append(f"{runs[0].path}: no sensors, so no output figure")
+
+
+def build_figures(runs: list[RunData], request: PlotRequest, folder: Path | None = None) -> tuple[dict, list]:
+    """{figure kind: figure} and notes for the user; reads nothing from disk but the measurement."""
+    show, notes, figures = request.show, [], {}
+    chosen = list(request.sensors)
+    _signals_figure(runs, chosen, figures, notes, show)
+    for joint in _clearance_joints(runs):
+        figures[f"joint-{joint}"] = journal.joint_figure(runs, joint, show)
+    spectrum = _spectrum_sensors(runs, chosen)
+    if spectrum:
+        figures["spectrum"] = history.spectrum_figure(runs, spectrum, show)
+    figures["energy"] = history.energy_figure(runs, show)
+    if request.measured is not None:
+        measurement = measured_plots.within(measured_plots.read_measurement(request.measured),
+                                            parse_time_window(request.time_window))
+        names = measured_plots.matched_sensors(measurement, runs, chosen)
+        figures["measured"] = measured_plots.measured_figure(runs, measurement, names, show)
+    summary = sweep.summary_of(folder) if folder is not None else None
+    if summary is not None:
+        figures["merit"] = sweep.merit_figure(summary, f"sweep folder {folder.name}", show)
+    notes += [f"{run.path} is incomplete ({run.attrs.get('status', 'unknown')}): plotted up to "
+              f"{run.time[-1] * 1e3:.3f} ms" for run in runs if not run.complete]
+    return figures, notes
+
+
+def _output_folder(request: PlotRequest, inputs: _Inputs) -> Path:
+    if request.out is not None:
+        return Path(request.out)
+    return inputs.folder if inputs.folder is not None else inputs.files[0].parent
+
+
+def _save(figures: dict, folder: Path, stem: str, fmt: str) -> list[Path]:
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    for kind, figure in figures.items():
+        path = folder / f"{stem}-{kind}.{fmt}"
+        figure.savefig(path, format=fmt, dpi=DPI)
+        written.append(path)
+    return written
+
+
+def plot_results(request: PlotRequest) -> PlotReport:
+    """Read the inputs, build every figure, then write them (and the animations); paths and notes."""
+    if request.fmt not in FORMATS:
+        raise PlotInputError(f"--format {request.fmt!r}: expected one of {', '.join(FORMATS)}")
+    inputs = _inputs(request.inputs)
+    runs = _load(inputs, request)
+    exaggerate = parse_exaggerate(request.exaggerate)
+    for run in runs if request.animate else []:
+        check_animation(run)
+    figures, notes = build_figures(runs, request, inputs.folder)
+    folder = _output_folder(request, inputs)
+    written = _save(figures, folder, inputs.stem, request.fmt)
+    if request.animate:
+        for run in runs:
+            written.append(animate_run(run, folder / f"{run.path.stem}-animation.gif", exaggerate))
+    if request.show and (note := show_all()):
+        notes.append(note)
+    return PlotReport(written, notes)

@@ -1,0 +1,167 @@
+"""Time histories of sensors, their spectra, and the energy / constraint diagnostic page.
+
+Every function takes a list of runs (one run, or several overlaid with their labels) and
+`ax=None`, and returns the axes it drew on.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from clearsim.plot.data import RunData
+from clearsim.plot.scales import FREQUENCY, TIME, scale_for
+from clearsim.plot.style import axes_or_new, new_figure, run_style, set_title, title_of
+
+ENERGY_KINDS = ("kinetic", "potential", "driver_work", "applied_work", "contact_dissipated",
+                "friction_dissipated", "damping_dissipated")
+VIOLATION_FLOOR = 1e-18  # m: stands for an exact zero on the logarithmic axis
+ENVELOPE_BINS = 300  # the violation jumps between 0 (just projected) and ~1e-13 m: draw its envelope
+
+
+def pretty(name: str) -> str:
+    return name.replace("_", " ")
+
+
+def _sensor_scale(runs: list[RunData], sensor: str):
+    key = f"sensors/{sensor}"
+    values = np.concatenate([run.series(key, f"sensor {sensor}") for run in runs])
+    return scale_for(runs[0].unit(key), values)
+
+
+def plot_signal(runs: list[RunData], sensor: str, ax=None):
+    """A sensor against time, one line per run, in engineering units."""
+    ax = axes_or_new(ax)
+    scale = _sensor_scale(runs, sensor)
+    for run in runs:
+        ax.plot(TIME(run.time), scale(run.series(f"sensors/{sensor}")), label=run.label or run.name,
+                **run_style(run))
+    ax.set_ylabel(scale.label(pretty(sensor)))
+    ax.set_xlabel(TIME.label("time"))
+    if len(runs) > 1:
+        ax.legend(loc="best")
+    return ax
+
+
+def signals_figure(runs: list[RunData], sensors: list[str], interactive: bool = False):
+    """One axis per sensor, stacked with a shared time axis (paper Fig. 7/8: x, v, a of the output)."""
+    figure = new_figure((8.0, 2.3 * len(sensors) + 0.8), interactive)
+    axes = figure.subplots(len(sensors), 1, sharex=True, squeeze=False)[:, 0]
+    for ax, sensor in zip(axes, sensors):
+        plot_signal(runs, sensor, ax)
+        if ax is not axes[-1]:
+            ax.set_xlabel("")
+        if ax is not axes[0] and ax.get_legend():
+            ax.get_legend().remove()
+    what = "output" if len(runs) == 1 else f"{len(runs)} runs"
+    set_title(figure, f"{title_of(runs[0])}\n{what}: " + ", ".join(pretty(s) for s in sensors))
+    return figure
+
+
+def amplitude_spectrum(time: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided amplitude spectrum (Hann window, mean removed): a sine of amplitude A shows as ≈ A."""
+    if len(time) < 4:
+        return np.zeros(0), np.zeros(0)
+    step = float(np.median(np.diff(time)))
+    window = np.hanning(len(values))
+    centred = np.asarray(values, float) - np.mean(values)
+    amplitude = 2.0 * np.abs(np.fft.rfft(centred * window)) / np.sum(window)
+    return np.fft.rfftfreq(len(values), step), amplitude
+
+
+def plot_spectrum(runs: list[RunData], sensor: str, ax=None):
+    """Amplitude spectrum of a sensor, frequency in kHz, logarithmic amplitude."""
+    ax = axes_or_new(ax)
+    unit = scale_for(runs[0].unit(f"sensors/{sensor}"), [1.0]).unit
+    for run in runs:
+        frequency, amplitude = amplitude_spectrum(run.time, run.series(f"sensors/{sensor}"))
+        ax.semilogy(FREQUENCY(frequency[1:]), amplitude[1:], label=run.label or run.name, **run_style(run))
+    ax.set_xlabel(FREQUENCY.label("frequency"))
+    ax.set_ylabel(f"amplitude of {pretty(sensor)} ({unit})")
+    ax.set_xlim(left=0.0)
+    if len(runs) > 1:
+        ax.legend(loc="best")
+    return ax
+
+
+def spectrum_figure(runs: list[RunData], sensors: list[str], interactive: bool = False):
+    figure = new_figure((8.0, 2.6 * len(sensors) + 0.9), interactive)
+    axes = figure.subplots(len(sensors), 1, squeeze=False)[:, 0]
+    for ax, sensor in zip(axes, sensors):
+        plot_spectrum(runs, sensor, ax)
+    start, end = runs[0].time[0], runs[0].time[-1]
+    set_title(figure, f"{title_of(runs[0])}\namplitude spectrum, {TIME(start):.4g}–{TIME(end):.4g} ms (Hann window)")
+    return figure
+
+
+def plot_energies(run: RunData, ax=None):
+    """Kinetic energy, change of potential energy, works and dissipations (J) against time."""
+    ax = axes_or_new(ax)
+    for kind in ENERGY_KINDS:
+        key = f"energy/{kind}"
+        if not run.has(key):
+            continue
+        values = run.series(key)
+        if not np.any(values):
+            continue
+        label = pretty(kind)
+        if kind == "potential":
+            values, label = values - values[0], "potential (change)"
+        ax.plot(TIME(run.time), values, label=label)
+    ax.set_ylabel("energy (J)")
+    ax.set_xlabel(TIME.label("time"))
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    return ax
+
+
+def plot_balance_error(runs: list[RunData], ax=None):
+    """The energy balance error E − E(0) − W + D (J): zero for exact integration."""
+    ax = axes_or_new(ax)
+    for run in runs:
+        error = run.series("energy/balance_error", "the energy balance")
+        reference = max(float(np.max(np.abs(run.series("energy/kinetic", "the energy balance")))), 1e-300)
+        label = f"{run.label or run.name}: max |error| {np.max(np.abs(error)):.3g} J " \
+                f"({np.max(np.abs(error)) / reference:.2g} of peak kinetic energy)"
+        ax.plot(TIME(run.time), error, label=label, **run_style(run))
+    ax.set_ylabel("balance error (J)")
+    ax.set_xlabel(TIME.label("time"))
+    ax.legend(loc="best")
+    return ax
+
+
+def envelope(time: np.ndarray, values: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray]:
+    """(bin centres, max of |values| per bin): the upper envelope of a noisy series."""
+    if len(values) <= bins:
+        return time, np.abs(values)
+    edges = np.linspace(0, len(values), bins + 1).astype(int)
+    peaks = np.maximum.reduceat(np.abs(values), edges[:-1])
+    centres = 0.5 * (time[edges[:-1]] + time[np.minimum(edges[1:], len(time)) - 1])
+    return centres, peaks
+
+
+def plot_violation(runs: list[RunData], ax=None):
+    """max |Φ| of the ideal joints (m), logarithmic: its upper envelope over ENVELOPE_BINS bins."""
+    ax = axes_or_new(ax)
+    for run in runs:
+        violation = run.series("constraints/violation", "the constraint violation")
+        time, peaks = envelope(run.time, violation, ENVELOPE_BINS)
+        ax.semilogy(TIME(time), np.maximum(peaks, VIOLATION_FLOOR),
+                    label=f"{run.label or run.name}: max {np.max(violation):.2g} m", **run_style(run))
+    ax.set_ylabel("constraint violation\nmax |Φ| (m)")
+    ax.set_xlabel(TIME.label("time"))
+    ax.legend(loc="best")
+    return ax
+
+
+def energy_figure(runs: list[RunData], interactive: bool = False):
+    """Diagnostic page: energies (one run), balance error and constraint violation (all runs)."""
+    panels = 3 if len(runs) == 1 else 2
+    figure = new_figure((8.0, 2.5 * panels + 0.8), interactive)
+    axes = figure.subplots(panels, 1, sharex=True)
+    if panels == 3:
+        plot_energies(runs[0], axes[0])
+    plot_balance_error(runs, axes[-2])
+    plot_violation(runs, axes[-1])
+    for ax in axes[:-1]:
+        ax.set_xlabel("")
+    set_title(figure, f"{title_of(runs[0])}\nenergy balance and constraint violation (diagnostics)")
+    return figure

@@ -1,0 +1,110 @@
+"""Running a plan: cases to the executor, outcomes back, the summary written even when interrupted."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+from clearsim.errors import ClearsimError
+from clearsim.sweep.grid import SweepOptionError
+from clearsim.sweep.plan import CASES_FILE, SweepPlan, write_cases
+from clearsim.sweep.summary import (PERCENTILES_FILE, SUMMARY_FILE, percentile_header, percentiles,
+                                    summary_rows, write_csv)
+from clearsim.sweep.worker import COMPLETE, FAILED, INTERRUPTED, NOT_RUN, CaseOutcome, CaseTask, run_case
+
+Progress = Callable[[CaseOutcome, int, int], None]  # (outcome, finished, total)
+
+
+@dataclass
+class SweepResult:
+    plan: SweepPlan
+    outcomes: dict[str, CaseOutcome]
+    header: list[str]
+    rows: list[dict]
+    summary: Path
+    percentiles: list[dict] = field(default_factory=list)
+    interrupted: bool = False
+
+    def count(self, state: str) -> int:
+        return sum(1 for o in self.outcomes.values() if o.state == state)
+
+    @property
+    def ran(self) -> list[str]:
+        """Cases computed by this call (the others were complete already)."""
+        return [name for name, o in self.outcomes.items() if o.ran]
+
+    @property
+    def failed(self) -> list[CaseOutcome]:
+        return [o for o in self.outcomes.values() if o.state == FAILED]
+
+
+def case_file(plan: SweepPlan, name: str) -> Path:
+    return plan.folder / f"{name}.h5"
+
+
+def tasks_of(plan: SweepPlan, retry_failed: bool = False) -> list[CaseTask]:
+    return [CaseTask(case.name, plan.config_text, str(plan.config), str(plan.base_dir), case.overrides,
+                     str(case_file(plan, case.name)), retry_failed) for case in plan.cases]
+
+
+def run_sweep(plan: SweepPlan, executor, progress: Progress | None = None,
+              retry_failed: bool = False) -> SweepResult:
+    """Run every case not done yet; summary.csv (and percentiles.csv) describe every case.
+
+    Ctrl-C stops the sweep: finished cases stay, the summary lists the others as not run, and
+    KeyboardInterrupt is raised again once the files are written.
+    """
+    _check_folder(plan.folder)
+    executor.connect()
+    plan.folder.mkdir(parents=True, exist_ok=True)
+    write_cases(plan)
+    outcomes: dict[str, CaseOutcome] = {}
+    tasks = tasks_of(plan, retry_failed)
+
+    def collect(outcome: CaseOutcome) -> None:
+        outcomes[outcome.name] = outcome
+        if progress is not None:
+            progress(outcome, len(outcomes), len(tasks))
+
+    try:
+        interrupted = executor.run(run_case, tasks, collect)
+    except KeyboardInterrupt:
+        interrupted = True
+    interrupted = interrupted or any(o.state in (INTERRUPTED, NOT_RUN) for o in outcomes.values())
+    result = _summarize(plan, outcomes, interrupted)
+    if interrupted:
+        raise SweepInterrupted(result)
+    return result
+
+
+def _check_folder(folder: Path) -> None:
+    """A sweep writes into a new folder or one of its own (with cases.json), never among other files."""
+    if folder.exists() and (not folder.is_dir() or (any(folder.iterdir()) and not (folder / CASES_FILE).exists())):
+        raise SweepOptionError(f"--out {folder}: not a sweep folder (it holds other files and no {CASES_FILE})\n"
+                               "  hint: give a new folder, or leave out --out for one under results/")
+
+
+def _summarize(plan: SweepPlan, outcomes: dict[str, CaseOutcome], interrupted: bool) -> SweepResult:
+    ordered = {case.name: outcomes[case.name] for case in plan.cases if case.name in outcomes}
+    header, rows = summary_rows(plan, ordered)
+    summary = write_csv(plan.folder / SUMMARY_FILE, header, rows)
+    table = percentiles(plan, header, rows) if plan.sampled else []
+    if table:
+        write_csv(plan.folder / PERCENTILES_FILE, percentile_header(), table)
+    return SweepResult(plan, ordered, header, rows, summary, table, interrupted)
+
+
+class SweepFailed(ClearsimError):
+    """Some cases of a sweep failed (the others finished and are in the summary)."""
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a sweep; `result` holds what had finished (already written to summary.csv)."""
+
+    def __init__(self, result: SweepResult):
+        super().__init__()
+        self.result = result
+
+
+__all__ = ["COMPLETE", "FAILED", "SweepFailed", "SweepInterrupted", "SweepResult", "case_file", "run_sweep"]

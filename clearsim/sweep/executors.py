@@ -1,0 +1,146 @@
+"""Where the cases run: a local process pool, or an existing Dask distributed cluster.
+
+Both hand each outcome to a callback as its case finishes. Ctrl-C cancels the cases not yet
+started; cases already running in the pool are interrupted (their files flagged incomplete) and
+their outcomes still collected, so the summary matches the files. A second Ctrl-C leaves at once.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+import uuid
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from typing import Callable, Sequence
+
+from clearsim.sweep.grid import SweepOptionError
+from clearsim.sweep.worker import FAILED, CaseOutcome, CaseTask, init_pool_worker
+
+Collect = Callable[[CaseOutcome], None]
+
+
+def available_cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:
+        return os.cpu_count() or 1
+
+
+def _lost(task: CaseTask, exc: BaseException) -> CaseOutcome:
+    """A case whose worker died (killed, out of memory): recorded like a failure."""
+    return CaseOutcome(task.name, FAILED, True, f"worker lost: {type(exc).__name__}: {exc}")
+
+
+class LocalPool:
+    """A pool of `workers` processes (default: all cores), each running many cases."""
+
+    def __init__(self, workers: int | None = None):
+        if workers is not None and workers < 1:
+            raise SweepOptionError(f"--workers must be at least 1, got {workers}")
+        self.workers = workers or available_cores()
+
+    def describe(self) -> str:
+        return f"{self.workers} local worker process{'es' if self.workers > 1 else ''}"
+
+    def connect(self) -> None:
+        """Nothing to connect to: the processes start with the first case."""
+
+    def run(self, function: Callable, tasks: Sequence[CaseTask], collect: Collect) -> bool:
+        """Run every task, passing each outcome to `collect`; True when Ctrl-C stopped the sweep."""
+        if not tasks:
+            return False
+        # spawn, not fork: the parent may hold threads (the progress bar) and numba state
+        context = multiprocessing.get_context("spawn")
+        stop = context.Event()
+        pool = ProcessPoolExecutor(min(self.workers, len(tasks)), mp_context=context,
+                                   initializer=init_pool_worker, initargs=(stop,))
+        futures = {pool.submit(function, task): task for task in tasks}
+        remaining, interrupted = set(futures), False
+        try:
+            while remaining:
+                try:
+                    _collect_finished(futures, remaining, collect)
+                except KeyboardInterrupt:
+                    if interrupted:
+                        raise  # a second Ctrl-C: leave without waiting for the running cases
+                    interrupted = True
+                    stop.set()  # cases already handed to a process return at once instead of starting
+                    _interrupt_workers(pool)
+                    remaining = {future for future in remaining if not future.cancel()}
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+        return interrupted
+
+
+def _collect_finished(futures: dict, remaining: set, collect: Collect) -> None:
+    done, _ = wait(remaining, return_when=FIRST_COMPLETED)
+    for future in done:
+        remaining.discard(future)
+        collect(_result(future, futures[future]))
+
+
+def _interrupt_workers(pool: ProcessPoolExecutor) -> None:
+    """Ask the running cases to stop and flag their files (a SIGTERM reaches only this process)."""
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        try:
+            os.kill(process.pid, signal.SIGINT)
+        except (OSError, AttributeError):
+            pass
+
+
+def _result(future, task: CaseTask) -> CaseOutcome:
+    try:
+        return future.result()
+    except Exception as exc:
+        return _lost(task, exc)
+
+
+class DaskCluster:
+    """An existing dask.distributed cluster at `address` (tcp://host:8786); its workers need clearsim
+    installed and the sweep folder on a shared file system at the same path."""
+
+    def __init__(self, address: str, workers: int | None = None):
+        if workers is not None:
+            raise SweepOptionError("--workers sizes the local pool; a Dask cluster runs as many cases "
+                                   "at once as its workers have threads")
+        self.address = address
+        self.client = None
+
+    def describe(self) -> str:
+        return f"the Dask cluster at {self.address}"
+
+    def connect(self) -> None:
+        """Reach the scheduler before anything is written (an unreachable one is an input error)."""
+        if self.client is None:
+            self.client = self._client()
+
+    def _client(self):
+        try:
+            from distributed import Client
+        except ImportError:
+            raise SweepOptionError("--scheduler needs dask.distributed: pip install 'dask[distributed]'") from None
+        try:
+            return Client(self.address, timeout="10s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise SweepOptionError(f"--scheduler: cannot reach the Dask scheduler at {self.address} ({exc})\n"
+                                   "  hint: start one with `dask scheduler` and workers with `dask worker ADDRESS`") from None
+
+    def run(self, function: Callable, tasks: Sequence[CaseTask], collect: Collect) -> bool:
+        """As LocalPool.run; on Ctrl-C the cases not started are cancelled, running ones finish on the cluster."""
+        from distributed import as_completed
+
+        self.connect()
+        client, self.client = self.client, None
+        futures, token = {}, uuid.uuid4().hex[:8]
+        try:
+            for task in tasks:
+                futures[client.submit(function, task, key=f"clearsim-{token}-{task.name}", pure=False)] = task
+            for future in as_completed(list(futures)):
+                collect(_result(future, futures[future]))
+        except KeyboardInterrupt:
+            return True
+        finally:
+            client.cancel(list(futures))
+            client.close()
+        return False

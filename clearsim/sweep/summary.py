@@ -1,0 +1,101 @@
+"""The sweep's summary: one row per case (summary.csv), and percentiles for Monte Carlo (percentiles.csv)."""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+
+from clearsim.sweep.figures import CaseRecord, relative_figures
+from clearsim.sweep.plan import SweepPlan
+from clearsim.sweep.worker import NOT_RUN, CaseOutcome
+
+SUMMARY_FILE = "summary.csv"
+PERCENTILES_FILE = "percentiles.csv"
+PERCENTILES = (5, 25, 50, 75, 95)
+FIGURES = ("peak_acceleration_m_s2", "acceleration_ratio", "start_delay_ms", "end_error_percent")
+JOINT_FIGURES = ("max_contact_force_N", "free_percent", "impact_percent", "contact_percent")
+TAIL = ("steps", "rejected_steps", "wall_time_s", "reused", "error")
+
+
+def joint_column(figure: str, joint: str) -> str:
+    return f"{figure}[{joint}]"
+
+
+def clearance_joints(outcomes: dict[str, CaseOutcome]) -> list[str]:
+    joints = [j for o in outcomes.values() if o.record is not None for j in o.record.contact]
+    return list(dict.fromkeys(joints))
+
+
+def columns(plan: SweepPlan, joints: list[str]) -> list[str]:
+    per_joint = [joint_column(f, j) for j in joints for f in JOINT_FIGURES]
+    return ["case", "reference", *plan.labels, "status", *FIGURES, *per_joint, *TAIL]
+
+
+def _joint_cells(record: CaseRecord, joints: list[str]) -> dict:
+    cells = {}
+    for joint in joints:
+        force, free, impact, contact = record.contact.get(joint, (math.nan,) * 4)
+        cells.update({joint_column("max_contact_force_N", joint): force,
+                      joint_column("free_percent", joint): free * 100, joint_column("impact_percent", joint): impact * 100,
+                      joint_column("contact_percent", joint): contact * 100})
+    return cells
+
+
+def case_row(plan: SweepPlan, name: str, outcomes: dict[str, CaseOutcome], joints: list[str]) -> dict:
+    """A case's row: swept values, status, figures (blank when the case did not complete)."""
+    case = plan.case(name)
+    outcome = outcomes.get(name)
+    row = {"case": name, "reference": case.reference or "", **case.values,
+           "status": outcome.state if outcome else NOT_RUN, "error": outcome.error if outcome else ""}
+    record = outcome.record if outcome else None
+    if record is None:
+        return row
+    row.update({"steps": record.steps, "rejected_steps": record.rejected_steps, "wall_time_s": record.wall_time,
+                "reused": "yes" if not outcome.ran else "no"})
+    if record.complete:
+        reference = outcomes.get(case.reference) if case.reference else None
+        ideal = reference.record if reference is not None else (record if case.ideal else None)
+        row["peak_acceleration_m_s2"] = record.peak_acceleration
+        row.update(relative_figures(record, ideal, plan.delay_fraction))
+        row.update(_joint_cells(record, joints))
+    return row
+
+
+def summary_rows(plan: SweepPlan, outcomes: dict[str, CaseOutcome]) -> tuple[list[str], list[dict]]:
+    joints = clearance_joints(outcomes)
+    return columns(plan, joints), [case_row(plan, case.name, outcomes, joints) for case in plan.cases]
+
+
+def _cell(value) -> str:
+    if isinstance(value, float):
+        return "" if math.isnan(value) else repr(value)
+    return "" if value is None else str(value)
+
+
+def write_csv(path: Path, header: list[str], rows: list[dict]) -> Path:
+    with path.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(header)
+        writer.writerows([[_cell(row.get(key)) for key in header] for row in rows])
+    return path
+
+
+def percentiles(plan: SweepPlan, header: list[str], rows: list[dict]) -> list[dict]:
+    """Per figure of merit, over the complete non-ideal cases: count and percentiles."""
+    figures = [key for key in header if key in FIGURES or key.split("[")[0] in JOINT_FIGURES]
+    sampled = [row for row in rows if not plan.case(row["case"]).ideal and row.get("status") == "complete"]
+    table = []
+    for figure in figures:
+        values = np.array([row.get(figure, math.nan) for row in sampled], dtype=float)
+        values = values[np.isfinite(values)]
+        entry = {"figure": figure, "cases": len(values)}
+        entry.update({f"p{p}": float(np.percentile(values, p)) if len(values) else math.nan for p in PERCENTILES})
+        table.append(entry)
+    return table
+
+
+def percentile_header() -> list[str]:
+    return ["figure", "cases", *(f"p{p}" for p in PERCENTILES)]

@@ -1,0 +1,154 @@
+"""One case, where it runs (a process of the local pool or a Dask worker).
+
+A worker process imports clearsim once and runs many cases; the compiled kernels come from
+numba's on-disk cache, so no case compiles. A case whose file is complete (same resolved YAML)
+is not run again: that is how a re-run sweep resumes. Ctrl-C reaches the pool's processes too;
+a process ignores it between cases and turns it into an orderly interruption during one (the
+result file is closed and flagged `complete = false`, and is run again on resume).
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+
+from clearsim.errors import ClearsimError
+from clearsim.io.hdf5 import NotAResultFile, read_result
+from clearsim.model.loader import load_mechanism_text
+from clearsim.runner import prepare, run_to_file
+from clearsim.sweep.figures import CaseRecord, read_record
+
+COMPLETE, FAILED, INTERRUPTED, NOT_RUN = "complete", "failed", "interrupted", "not run"
+
+
+@dataclass(frozen=True)
+class CaseTask:
+    """Everything a worker needs: the YAML text (not its path), the overrides, the output file."""
+
+    name: str
+    config_text: str
+    config_name: str
+    base_dir: str
+    overrides: tuple[str, ...]
+    output: str
+    retry_failed: bool = False
+
+
+@dataclass
+class CaseOutcome:
+    name: str
+    state: str  # complete, failed, interrupted
+    ran: bool  # False: an earlier result was reused
+    error: str = ""
+    record: CaseRecord | None = None
+
+
+_interrupted = False  # this process's case was interrupted (what it raised then is a consequence)
+_stop = None  # set by the main process of a local pool: cases that have not started yet are skipped
+
+
+def init_pool_worker(stop) -> None:
+    """Pool initializer: an idle worker ignores Ctrl-C (the main process decides what stops)."""
+    global _stop
+    _stop = stop
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    sys.unraisablehook = _quiet_interrupts
+
+
+def _quiet_interrupts(unraisable) -> None:
+    """A Ctrl-C that lands in a finaliser is dropped there (the case then completes): no traceback."""
+    if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+        sys.__unraisablehook__(unraisable)
+
+
+def _interrupt(signum, frame):
+    global _interrupted
+    _interrupted = True
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # one interruption per case: the file is closed undisturbed
+    raise KeyboardInterrupt
+
+
+def run_case(task: CaseTask) -> CaseOutcome:
+    """Run (or reuse) one case; failures and interruptions are outcomes, not exceptions."""
+    if _stop is not None and _stop.is_set():
+        return CaseOutcome(task.name, NOT_RUN, False, "cancelled")
+    in_main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, _interrupt) if in_main_thread else None
+    try:
+        try:
+            return _attempt_recorded(task)
+        except KeyboardInterrupt:
+            return _after_interrupt(task)
+        finally:
+            if in_main_thread:
+                signal.signal(signal.SIGINT, previous)
+    except KeyboardInterrupt:  # the case's one interruption came while the handler was being restored
+        return _after_interrupt(task)
+
+
+def _attempt_recorded(task: CaseTask) -> CaseOutcome:
+    global _interrupted
+    _interrupted = False
+    try:
+        return _attempt(task)
+    except ClearsimError as exc:
+        return CaseOutcome(task.name, FAILED, True, str(exc))
+    except Exception as exc:  # a bug must not stop the other cases; its text goes to the summary
+        text = f"internal error: {type(exc).__name__}: {exc}"
+        return CaseOutcome(task.name, INTERRUPTED if _interrupted else FAILED, True, text)
+
+
+def _attempt(task: CaseTask) -> CaseOutcome:
+    loaded = load_mechanism_text(task.config_text, task.config_name, task.overrides, Path(task.base_dir))
+    output = Path(task.output)
+    output_sensors = loaded.mechanism.output
+    if _reusable(output, loaded.resolved_yaml, task.retry_failed):
+        return _outcome(task.name, output, output_sensors, ran=False)
+    system = prepare(loaded)
+    report = run_to_file(system, loaded, output)
+    if isinstance(report.error, KeyboardInterrupt):
+        raise KeyboardInterrupt
+    return _outcome(task.name, output, output_sensors, ran=True)
+
+
+def _after_interrupt(task: CaseTask) -> CaseOutcome:
+    """An interruption that came after the file was complete (reading it back) leaves a complete case."""
+    try:
+        loaded = load_mechanism_text(task.config_text, task.config_name, task.overrides, Path(task.base_dir))
+        output = Path(task.output)
+        if output.exists() and read_result(output)["attrs"].get("complete"):
+            return _outcome(task.name, output, loaded.mechanism.output, ran=True)
+    except (ClearsimError, NotAResultFile, OSError):
+        pass
+    return CaseOutcome(task.name, INTERRUPTED, True, "interrupted")
+
+
+def _outcome(name: str, output: Path, output_sensors, ran: bool) -> CaseOutcome:
+    record = read_record(output, output_sensors)
+    if record.complete:
+        return CaseOutcome(name, COMPLETE, ran, "", record)
+    error = record.status.removeprefix("failed: ")
+    return CaseOutcome(name, FAILED, ran, error, record)
+
+
+def _reusable(output: Path, resolved_yaml: str, retry_failed: bool) -> bool:
+    """Whether an existing file is this case's result; an unusable one is cleared away."""
+    if not output.exists():
+        return False
+    try:
+        attrs = read_result(output)["attrs"]
+    except (NotAResultFile, OSError):
+        output.unlink()  # a file cut short by a hard kill
+        return False
+    same = attrs.get("config_yaml") == resolved_yaml
+    status = str(attrs.get("status", ""))
+    if same and (bool(attrs.get("complete")) or (status.startswith("failed") and not retry_failed)):
+        return True
+    if same:
+        output.unlink()  # interrupted, or failed and retried: this case's own file, nothing worth keeping
+    else:
+        output.replace(output.with_name(f"{output.stem}.previous{output.suffix}"))  # written from another YAML
+    return False

@@ -1,0 +1,144 @@
+"""Real sweeps of the Flores slider-crank (4 ms, the first impacts): figures of merit against the ideal
+case and a plain `clearsim run`, the local pool against a Dask cluster, resume, and a failing case."""
+
+import csv
+import shutil
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from clearsim.cli import app
+from clearsim.runner import summarize
+from clearsim.sweep import LocalPool, SweepFailed, SweepRequest, plan_sweep, run_sweep
+
+CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
+SLIDER_CRANK = CONFIGS / "slider_crank_flores.yaml"
+SHORT = "solver.t_end=4ms"  # first impacts at 0.23 ms: the largest forces of the 24 ms run are in here
+CLEARANCES = "0.25,0.5"
+CASES = ["ideal", "clearance-0.25_mm", "clearance-0.5_mm"]
+RUN_DEPENDENT = {"wall_time_s", "reused"}
+runner = CliRunner()
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def read_summary(folder: Path) -> dict[str, dict]:
+    with (folder / "summary.csv").open(newline="") as handle:
+        return {row["case"]: row for row in csv.DictReader(handle)}
+
+
+def numbers(row: dict) -> dict:
+    return {key: value for key, value in row.items() if key not in RUN_DEPENDENT}
+
+
+@pytest.fixture(scope="module")
+def pool_sweep(tmp_path_factory):
+    out = tmp_path_factory.mktemp("pool") / "sweep"
+    result = invoke("sweep", SLIDER_CRANK, "--set", SHORT, "--clearance", CLEARANCES, "--workers", 2, "-o", out)
+    assert result.exit_code == 0, result.output
+    return out, result.output
+
+
+def test_the_sweep_folder_holds_a_file_per_case_the_case_list_and_the_summary(pool_sweep):
+    out, output = pool_sweep
+    assert sorted(p.name for p in out.iterdir()) == sorted([*(f"{c}.h5" for c in CASES), "cases.json", "summary.csv"])
+    assert f"sweep of 3 cases of slider_crank_flores.yaml on 2 local worker processes → {out}" in output
+    rows = read_summary(out)
+    assert list(rows) == CASES and all(row["status"] == "complete" for row in rows.values())
+    assert rows["clearance-0.5_mm"]["clearance"] == "0.5 mm" and rows["clearance-0.5_mm"]["reference"] == "ideal"
+
+
+def test_peak_acceleration_and_contact_force_grow_with_the_clearance(pool_sweep):
+    rows = read_summary(pool_sweep[0])
+    ideal, small, large = (rows[c] for c in CASES)
+    peak = [float(row["peak_acceleration_m_s2"]) for row in (ideal, small, large)]
+    force = [float(row[f"max_contact_force_N[slider_pin]"]) for row in (small, large)]
+    assert peak[0] < peak[1] < peak[2]
+    assert force[0] < force[1]
+    assert float(small["acceleration_ratio"]) == pytest.approx(peak[1] / peak[0], rel=1e-12)
+    shares = sum(float(large[f"{kind}_percent[slider_pin]"]) for kind in ("free", "impact", "contact"))
+    assert shares == pytest.approx(100.0)
+    # the ideal case is its own reference: ratio 1, no delay, no end error
+    assert (float(ideal["acceleration_ratio"]), float(ideal["start_delay_ms"]), float(ideal["end_error_percent"])) == (1, 0, 0)
+    assert 0 < float(large["end_error_percent"]) < 5  # the slider lags by a fraction of the 0.5 mm clearance (of a 0.1 m stroke)
+
+
+def test_the_ideal_case_equals_a_plain_run_of_the_same_config(pool_sweep, tmp_path):
+    plain = tmp_path / "plain.h5"
+    result = invoke("run", SLIDER_CRANK, "-o", plain, "--set", SHORT, "--set", "joints.slider_pin.clearance=0")
+    assert result.exit_code == 0, result.output
+    ideal = read_summary(pool_sweep[0])["ideal"]
+    summary = summarize(plain)
+    assert float(ideal["peak_acceleration_m_s2"]) == summary.peak_acceleration[1]
+    assert f"{summary.peak_acceleration[1]:.5g} m/s²" in result.output
+    large = read_summary(pool_sweep[0])["clearance-0.5_mm"]
+    plain_large = tmp_path / "large.h5"
+    invoke("run", SLIDER_CRANK, "-o", plain_large, "--set", SHORT, "--set", "joints.slider_pin.clearance=0.5 mm")
+    assert float(large["max_contact_force_N[slider_pin]"]) == summarize(plain_large).peak_contact_force["slider_pin"]
+
+
+def test_a_dask_cluster_gives_the_same_summary_numbers(pool_sweep, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    out = tmp_path / "dask"
+    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        result = invoke("sweep", SLIDER_CRANK, "--set", SHORT, "--clearance", CLEARANCES,
+                        "--scheduler", cluster.scheduler_address, "-o", out)
+    assert result.exit_code == 0, result.output
+    assert "on the Dask cluster at tcp://127.0.0.1:" in result.output
+    pool, dask = read_summary(pool_sweep[0]), read_summary(out)
+    assert {c: numbers(r) for c, r in dask.items()} == {c: numbers(r) for c, r in pool.items()}
+
+
+def test_a_rerun_runs_only_the_missing_case(pool_sweep, tmp_path):
+    out = tmp_path / "resume"
+    shutil.copytree(pool_sweep[0], out)
+    (out / "clearance-0.25_mm.h5").unlink()
+    before = (out / "clearance-0.5_mm.h5").stat().st_mtime_ns
+    plan = plan_sweep(SweepRequest(SLIDER_CRANK, [SHORT], CLEARANCES, out=out), SLIDER_CRANK)
+    result = run_sweep(plan, LocalPool(2))
+    assert result.ran == ["clearance-0.25_mm"]
+    assert (out / "clearance-0.5_mm.h5").stat().st_mtime_ns == before
+    rows = read_summary(out)
+    assert [rows[c]["reused"] for c in CASES] == ["yes", "no", "yes"]
+    assert {c: numbers(r) for c, r in rows.items()} == {c: numbers(r) for c, r in read_summary(pool_sweep[0]).items()}
+    assert not list(out.glob("*.previous.h5")) and not list(out.glob("*.1.h5"))
+
+
+def test_a_failing_case_is_recorded_and_the_others_finish(tmp_path):
+    out = tmp_path / "failing"
+    # a 50 µs minimum step cannot resolve a steel contact (~µs): only the clearance case with it fails
+    result = invoke("sweep", SLIDER_CRANK, "--set", "solver.t_end=1ms", "--clearance", "0.5",
+                    "--set", "solver.min_step=1e-12s,5e-5s", "--workers", 2, "-o", out)
+    assert result.exit_code == 2, result.output
+    failing = "clearance-0.5_mm__solver.min_step-5e-5s"
+    assert f"1 of 4 cases failed" in result.output and f"{failing}: at t = " in result.output
+    rows = read_summary(out)
+    assert [rows[c]["status"] for c in rows] == ["complete", "complete", "complete", "failed"]
+    assert "step size fell below solver.min_step" in rows[failing]["error"]
+    assert rows[failing]["peak_acceleration_m_s2"] == ""
+    plan = plan_sweep(SweepRequest(SLIDER_CRANK, ["solver.t_end=1ms", "solver.min_step=1e-12s,5e-5s"], "0.5", out=out),
+                      SLIDER_CRANK)
+    again = run_sweep(plan, LocalPool(1))
+    assert again.ran == [] and [o.name for o in again.failed] == [failing]  # kept, not re-run
+
+
+def test_monte_carlo_adds_percentiles_of_each_figure(tmp_path):
+    config = tmp_path / "toleranced.yaml"
+    config.write_text(SLIDER_CRANK.read_text() + "tolerances:\n  - {path: joints.slider_pin.clearance, "
+                      "distribution: uniform, low: 0.1 mm, high: 0.5 mm}\n")
+    out = tmp_path / "mc"
+    result = invoke("sweep", config, "--set", "solver.t_end=1ms", "--sample", 3, "--seed", 7, "--workers", 2, "-o", out)
+    assert result.exit_code == 0, result.output
+    rows = read_summary(out)
+    assert list(rows) == ["ideal", "sample-0001", "sample-0002", "sample-0003"]
+    assert all(row["joints.slider_pin.clearance"].endswith(" mm") for name, row in rows.items() if name != "ideal")
+    with (out / "percentiles.csv").open(newline="") as handle:
+        table = {row["figure"]: row for row in csv.DictReader(handle)}
+    peak = sorted(float(rows[f"sample-000{k}"]["peak_acceleration_m_s2"]) for k in (1, 2, 3))
+    assert table["peak_acceleration_m_s2"]["cases"] == "3"
+    assert float(table["peak_acceleration_m_s2"]["p50"]) == pytest.approx(peak[1], rel=1e-12)
+    assert "max_contact_force_N[slider_pin]" in table and "max_contact_force_N[slider_pin]" in result.output

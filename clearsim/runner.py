@@ -86,9 +86,9 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
             for chunk in run.chunks():
                 if initial_energy is None:
                     initial_energy = float(chunk.kinetic[0] + chunk.potential[0])
-                episodes.append(chunk.episodes)
                 provisional = sample_modes(classify_episodes(system, run.episode_log()), chunk.episodes)
                 writer.append(chunk.times, chunk_outputs(system, chunk, provisional, initial_energy))
+                episodes.append(chunk.episodes)  # only once written: an interrupt between the two keeps them aligned
                 if progress is not None:
                     progress(run.time)
         except SolverError as exc:

@@ -92,8 +92,8 @@ def _summary_table(report, summary) -> Table:
         table.add_row(f"peak |{summary.peak_acceleration[0]}|", f"{summary.peak_acceleration[1]:.5g} m/s²")
     for joint, force in summary.peak_contact_force.items():
         free, impact, contact = summary.contact_time_share[joint]
-        table.add_row(f"max contact force, joint {joint}",
-                      f"{force:.5g} N   (time free {free:.0%}, impact {impact:.0%}, contact {contact:.0%})")
+        table.add_row(f"joint {joint}: max contact force", f"{force:.5g} N")
+        table.add_row(f"joint {joint}: free / impact / contact", f"{free:.0%} / {impact:.0%} / {contact:.0%} of the time")
     table.add_row("steps (rejected)", f"{stats.steps} ({stats.rejected_steps})")
     table.add_row("contact events", f"{stats.contact_events}")
     table.add_row("wall time", f"{stats.wall_time:.3f} s (integration)")

@@ -1,3 +1,27 @@
 """clearsim: planar mechanisms with clearance joints."""
 
+import hashlib
+import os
+from pathlib import Path
+
 __version__ = "0.1.0"
+COMPILED_PACKAGES = ("assembly", "physics", "solver")  # the modules with numba kernels
+
+
+def _kernel_cache_dir() -> str:
+    """A numba cache folder keyed by the source of every compiled module.
+
+    numba's own cache notices a change only in the file that defines a function, not in the
+    functions it calls from other modules; keying the folder by all sources makes any change
+    recompile everything once (about 20 s) instead of running stale machine code.
+    """
+    digest = hashlib.sha256()
+    package = Path(__file__).parent
+    for folder in COMPILED_PACKAGES:
+        for source in sorted((package / folder).glob("*.py")):
+            digest.update(source.read_bytes())
+    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "clearsim" / "numba"
+    return str(base / digest.hexdigest()[:16])
+
+
+os.environ.setdefault("NUMBA_CACHE_DIR", _kernel_cache_dir())

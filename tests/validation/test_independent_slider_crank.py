@@ -126,8 +126,9 @@ def test_journal_path_over_the_first_revolution(case):
 def test_episodes_of_the_first_revolution_match_one_to_one(case):
     name, _, reference, full, _ = case
     theirs = episodes(full)
-    end = None if name == "friction" else ONE_REVOLUTION  # friction: the whole run
-    mine = [e for e in reference.episodes if end is None or e.onset < end]
+    # one to one over the first revolution only: the slow re-contacts later on (δ̇⁻ < 0.1 m/s) amplify
+    # round-off — the order of a sum in the constraint solver moves their δ̇⁻ by ~0.3 % (docs/model.md §6)
+    mine = [e for e in reference.episodes if e.onset < ONE_REVOLUTION]
     assert len(mine) >= 20
     assert len(theirs["onset"]) >= len(mine)
     onsets = np.array([e.onset for e in mine])

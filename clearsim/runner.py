@@ -16,7 +16,7 @@ import numpy as np
 from clearsim.assembly.build import BuildError
 from clearsim.assembly.system import System, assemble
 from clearsim.errors import InputError, SolverError
-from clearsim.io.hdf5 import ResultWriter, group_attribute, keep_existing, read_result
+from clearsim.io.hdf5 import ResultWriter, group_attribute, interrupts_deferred, keep_existing, read_result
 from clearsim.model.loader import LoadedMechanism, load_mechanism
 from clearsim.solver.outputs import classify_episodes, chunk_outputs, sample_modes
 from clearsim.solver.simulate import Run
@@ -87,8 +87,10 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                 if initial_energy is None:
                     initial_energy = float(chunk.kinetic[0] + chunk.potential[0])
                 provisional = sample_modes(classify_episodes(system, run.episode_log()), chunk.episodes)
-                writer.append(chunk.times, chunk_outputs(system, chunk, provisional, initial_energy))
-                episodes.append(chunk.episodes)  # only once written: an interrupt between the two keeps them aligned
+                outputs = chunk_outputs(system, chunk, provisional, initial_energy)
+                with interrupts_deferred():  # a chunk is written whole, with its episodes, or not at all
+                    writer.append(chunk.times, outputs)
+                    episodes.append(chunk.episodes)
                 if progress is not None:
                     progress(run.time)
         except SolverError as exc:

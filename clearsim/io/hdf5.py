@@ -8,7 +8,10 @@ file is never overwritten: it is first renamed to the next free `<stem>.<k>.h5`.
 
 from __future__ import annotations
 
+import contextlib
 import datetime as dt
+import signal
+import threading
 from pathlib import Path
 
 import h5py
@@ -27,6 +30,24 @@ def keep_existing(path: Path) -> Path | None:
         k += 1
     path.rename(backup)
     return backup
+
+
+@contextlib.contextmanager
+def interrupts_deferred():
+    """Hold Ctrl-C and SIGTERM until the block ends, so a write is never cut in half (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    received = []
+    previous = {sig: signal.signal(sig, lambda number, frame: received.append(number))
+                for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        if received:
+            raise KeyboardInterrupt
 
 
 class ResultWriter:
@@ -60,7 +81,9 @@ class ResultWriter:
         dataset[start:] = values
 
     def append(self, times: np.ndarray, datasets: dict) -> None:
-        """Add samples: /time and every `path → (values, unit)`; flushed to disk at once."""
+        """Add samples: /time and every `path → (values, unit)`; flushed to disk at once.
+
+        Hold interrupts around the call (`interrupts_deferred`) when a half-written chunk must not happen."""
         self._append("time", times, "s")
         for name, (values, unit) in datasets.items():
             self._append(name, values, unit)

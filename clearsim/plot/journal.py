@@ -81,22 +81,22 @@ def _plot_joint_series(runs: list[RunData], joint: str, name: str, scale, ax):
     return ax
 
 
+def _plot_force(runs: list[RunData], joint: str, dataset: str, label: str, ax):
+    ax = axes_or_new(ax)
+    scale = force_scale(np.concatenate([run.series(f"joints/{joint}/{dataset}") for run in runs]))
+    _plot_joint_series(runs, joint, dataset, scale, ax)
+    ax.set_ylabel(scale.label(label))
+    return ax
+
+
 def plot_contact_forces(runs: list[RunData], joint: str, ax=None):
     """Normal force F_n (≥ 0, on the journal along −n) against time."""
-    ax = axes_or_new(ax)
-    scale = force_scale(np.concatenate([run.series(f"joints/{joint}/normal_force") for run in runs]))
-    _plot_joint_series(runs, joint, "normal_force", scale, ax)
-    ax.set_ylabel(scale.label("normal force $F_n$"))
-    return ax
+    return _plot_force(runs, joint, "normal_force", "normal force $F_n$", ax)
 
 
 def plot_friction_force(runs: list[RunData], joint: str, ax=None):
     """Friction force F_t (signed, on the journal along +t) against time."""
-    ax = axes_or_new(ax)
-    scale = force_scale(np.concatenate([run.series(f"joints/{joint}/friction_force") for run in runs]))
-    _plot_joint_series(runs, joint, "friction_force", scale, ax)
-    ax.set_ylabel(scale.label("friction force $F_t$"))
-    return ax
+    return _plot_force(runs, joint, "friction_force", "friction force $F_t$", ax)
 
 
 def plot_penetration(runs: list[RunData], joint: str, ax=None):

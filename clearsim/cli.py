@@ -239,5 +239,30 @@ def draw(
     console.print(str(path), highlight=False, soft_wrap=True)
 
 
+@app.command()
+@user_errors
+def synthesize(
+    config: Optional[Path] = ConfigArgument,
+    overrides: List[str] = SetOption,
+    sensors: Optional[str] = typer.Option(None, "--sensors", help="Sensors to record: a,b (default: the output displacement and velocity)."),
+    rate: str = typer.Option("15kHz", "--rate", help="Sampling rate of the record."),
+    noise: str = typer.Option("0", "--noise", help="Sensor noise (std): 1% of each signal's range, or absolute with a unit: 0.02mm."),
+    lowpass: Optional[str] = typer.Option(None, "--lowpass", help="Cut-off of the bench's low-pass filter: 2kHz (default: none)."),
+    trigger_offset: str = typer.Option("0ms", "--trigger-offset", help="Trigger offset τ: measured(t) = sensor(t − τ)."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the noise."),
+    output: Path = typer.Option(Path("bench.csv"), "-o", "--output", help="Measured-like CSV to write."),
+    force: bool = typer.Option(False, "--force", help="Overwrite an existing output."),
+) -> None:
+    """Make measured-like data from a model: sensors sampled, shifted, noisy and filtered like a bench."""
+    from clearsim.diagnose.synthesize import SynthesisRequest, synthesize as make_record
+    from clearsim.runner import BUNDLED_CONFIG
+
+    chosen = [name.strip() for name in (sensors or "").split(",") if name.strip()]
+    record = make_record(SynthesisRequest(config or BUNDLED_CONFIG, overrides, chosen, rate, noise, lowpass,
+                                          trigger_offset, seed, output, force))
+    console.print(f"{record.output}: {len(record.time)} samples of {', '.join(record.values)} "
+                  f"over {record.time[-1] * 1e3:.3f} ms", highlight=False, soft_wrap=True)
+
+
 if __name__ == "__main__":
     app()

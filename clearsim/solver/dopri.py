@@ -39,17 +39,20 @@ def step(system, t, y, f, h, modes, speeds, stages, y_new):
     """One DOPRI5 step from (t, y) with ẏ(t) = f; fills stages (7, ny) and y_new; returns the error vector."""
     stages[0, :] = f
     work = np.empty_like(y)
+    # nodes at the step's end are evaluated just left of it: a prescribed motion may jump in acceleration
+    # exactly there (the end of a stroke), and the step must see the piece it integrates over
+    end = np.nextafter(t + h, t)
     for s in range(1, 6):
         work[:] = y
         for j in range(s):
             if MATRIX[s, j] != 0.0:
                 work += h * MATRIX[s, j] * stages[j]
-        rhs(system, t + NODES[s] * h, work, modes, speeds, stages[s])
+        rhs(system, min(t + NODES[s] * h, end), work, modes, speeds, stages[s])
     y_new[:] = y
     for j in range(6):
         if WEIGHTS[j] != 0.0:
             y_new += h * WEIGHTS[j] * stages[j]
-    rhs(system, t + h, y_new, modes, speeds, stages[6])
+    rhs(system, end, y_new, modes, speeds, stages[6])
     error = np.zeros_like(y)
     for j in range(STAGES):
         if ERROR_WEIGHTS[j] != 0.0:

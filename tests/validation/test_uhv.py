@@ -57,3 +57,10 @@ def test_clearance_at_a_and_j_raises_the_peak_acceleration_and_keeps_the_invaria
     assert ratio > 2.0  # the paper reports 3.58 with J alone; clearance shakes the output
     stroke_error = abs(result["sensors/contact_displacement"][-1] - ideal["sensors/contact_displacement"][-1])
     assert stroke_error < 1e-3  # m: the clearances of 0.01 mm cannot change the stroke by more than ~mm
+
+
+def test_the_stroke_ends_cleanly_with_a_journal_in_contact(simulate):
+    """The drive's acceleration jumps at t = 85 ms; a step ending there must integrate the stroke's last piece."""
+    result = simulate("uhv_breaker.yaml", "joints.A.clearance=0", "solver.output_rate=10kHz")
+    assert result["attrs"]["complete"] and result["time"][-1] == pytest.approx(0.085)
+    assert result["joints/J/mode"][-1] != 0  # the journal of J is in contact at the end of the stroke

@@ -95,7 +95,6 @@ def minimum_norm_correction(blocks, bodies, minv, residual, n):
 @njit(cache=True)
 def accelerations(system, t, q, qd, generalized):
     """(q̈, λ) from M q̈ + Φ_qᵀ λ = Q, Φ_q q̈ = γ."""
-    n = q.shape[0]
     m = constraint_count(system)
     minv = inverse_mass(system)
     if m == 0:

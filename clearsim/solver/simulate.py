@@ -14,7 +14,6 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from clearsim.assembly.arrays import CL_CLEARANCE
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints
 from clearsim.assembly.dynamics import WORK_COUNT, rhs
 from clearsim.assembly.forces import FREE

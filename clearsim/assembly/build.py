@@ -130,7 +130,12 @@ class Laws:
 
 
 def _motion_law(driver: schema.Driver, kind: str, base_dir: Path, path) -> motion.PiecewisePolynomial:
-    """The driver's law in SI units of its coordinate (kind 'length' or 'angle')."""
+    """The driver's law in SI units of its coordinate (kind 'length' or 'angle'), through the actuator's lag."""
+    return motion.lagged(_written_law(driver, kind, base_dir, path), driver.lag)
+
+
+def _written_law(driver: schema.Driver, kind: str, base_dir: Path, path) -> motion.PiecewisePolynomial:
+    """The driver's law as written, in SI units of its coordinate."""
     law = driver.motion
     rate_kind = "speed" if kind == "length" else "angular_speed"
     try:

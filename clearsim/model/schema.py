@@ -202,6 +202,7 @@ class Driver(Strict):
     body: str | None = Field(None, description="body whose coordinate is driven (with coordinate:)")
     coordinate: Literal["x", "y", "angle"] | None = Field(None, description="driven body coordinate: centre-of-mass x, y, or angle")
     motion: Motion
+    lag: Time = Field(0.0, ge=0.0, description="first-order lag τ of the actuator: the coordinate follows the law through τ ṡ + s = s_law (0: none)")
 
     @model_validator(mode="after")
     def _one_target(self):

@@ -62,13 +62,64 @@ def table_law(times: np.ndarray, values: np.ndarray, relative: bool = True) -> P
     return PiecewisePolynomial(np.array(breaks), np.array(pieces))
 
 
+def lagged(law: PiecewisePolynomial, lag: float, samples: int = 1200) -> PiecewisePolynomial:
+    """The law seen through a first-order actuator lag, τ ṡ + s = s_law, at rest on the law at its start.
+
+    Solved exactly for the law sampled finely and linear in between, then splined; beyond 20 τ after
+    the law's last break the transient (e^-20) is dropped and the lagged law is the particular
+    solution Σ_k (−τ)^k s_law^(k) of the law's last piece.
+    """
+    if lag <= 0.0:
+        return law
+    breaks, rows = law.breaks, law.coefficients
+    constant_start = len(breaks) > 1 and not np.any(rows[0, 1:])
+    start = breaks[1] if constant_start else breaks[0]
+    end = breaks[-1] + 20.0 * lag if breaks[-1] > start else start + 20.0 * lag
+    fine = np.linspace(start, end, 8 * samples + 1)
+    driven = law(fine)
+    response = _first_order_response(fine, driven, lag)
+    coarse = slice(None, None, 8)
+    spline = table_law(fine[coarse], response[coarse], relative=False)
+    head = PiecewisePolynomial(np.array([start - 1.0]), np.array([_pad([driven[0]])]))
+    tail = _steady_lagged_piece(law, lag, end)
+    return PiecewisePolynomial(np.concatenate([head.breaks, spline.breaks[:-1], tail.breaks]),
+                               np.vstack([head.coefficients, spline.coefficients[:-1], tail.coefficients]))
+
+
+def _first_order_response(times: np.ndarray, driven: np.ndarray, lag: float) -> np.ndarray:
+    """τ y' + y = u for u linear between samples, exact step by step, y(t_0) = u(t_0)."""
+    response = np.empty_like(driven)
+    response[0] = driven[0]
+    for k in range(len(times) - 1):
+        step = times[k + 1] - times[k]
+        decay = np.exp(-step / lag)
+        slope = (driven[k + 1] - driven[k]) / step
+        response[k + 1] = decay * response[k] + (1.0 - decay) * (driven[k] - slope * lag) + slope * step
+    return response
+
+
+def _steady_lagged_piece(law: PiecewisePolynomial, lag: float, at: float) -> PiecewisePolynomial:
+    """Σ_k (−τ)^k p^(k)(t) of the law's last piece p, re-expanded about `at` (the lag's particular solution)."""
+    from numpy.polynomial import Polynomial
+
+    last = Polynomial(law.coefficients[-1])
+    steady = sum((((-lag) ** k) * last.deriv(k) for k in range(1, MAX_COEFFICIENTS)), last)
+    shifted = steady(Polynomial([at - law.breaks[-1], 1.0]))
+    return PiecewisePolynomial(np.array([at]), np.array([_pad(shifted.coef[:MAX_COEFFICIENTS])]))
+
+
 @njit(cache=True)
 def evaluate_piecewise(breaks, coefficients, first, count, t):
-    """(s, ṡ, s̈) at t of the polynomial stored in rows first … first+count−1."""
-    piece = first
-    for p in range(first + 1, first + count):
-        if t >= breaks[p]:
-            piece = p
+    """(s, ṡ, s̈) at t of the polynomial stored in rows first … first+count−1 (binary search for the piece)."""
+    low = first
+    high = first + count - 1
+    while low < high:  # the last piece whose break is <= t (the first piece extends to -inf)
+        middle = (low + high + 1) // 2
+        if t >= breaks[middle]:
+            low = middle
+        else:
+            high = middle - 1
+    piece = low
     x = t - breaks[piece]
     value = 0.0
     rate = 0.0

@@ -39,6 +39,7 @@ class LocalPool:
         if workers is not None and workers < 1:
             raise SweepOptionError(f"--workers must be at least 1, got {workers}")
         self.workers = workers or available_cores()
+        self._pool, self._stop = None, None
 
     def describe(self) -> str:
         return f"{self.workers} local worker process{'es' if self.workers > 1 else ''}"
@@ -46,15 +47,38 @@ class LocalPool:
     def connect(self) -> None:
         """Nothing to connect to: the processes start with the first case."""
 
+    def open(self) -> "LocalPool":
+        """Keep the worker processes between `run` calls (diagnose runs many small batches) until `close`."""
+        if self._pool is None:
+            self._pool, self._stop = self._start(self.workers)
+        return self
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool, self._stop = None, None
+
+    def __enter__(self) -> "LocalPool":
+        return self.open()
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    @staticmethod
+    def _start(workers: int):
+        # spawn, not fork: the parent may hold threads (the progress bar) and numba state
+        context = multiprocessing.get_context("spawn")
+        stop = context.Event()
+        pool = ProcessPoolExecutor(workers, mp_context=context, initializer=init_pool_worker, initargs=(stop,))
+        return pool, stop
+
     def run(self, function: Callable, tasks: Sequence[CaseTask], collect: Collect) -> bool:
         """Run every task, passing each outcome to `collect`; True when Ctrl-C stopped the sweep."""
         if not tasks:
             return False
-        # spawn, not fork: the parent may hold threads (the progress bar) and numba state
-        context = multiprocessing.get_context("spawn")
-        stop = context.Event()
-        pool = ProcessPoolExecutor(min(self.workers, len(tasks)), mp_context=context,
-                                   initializer=init_pool_worker, initargs=(stop,))
+        kept = self._pool is not None
+        pool, stop = (self._pool, self._stop) if kept else self._start(min(self.workers, len(tasks)))
+        stop.clear()
         futures = {pool.submit(function, task): task for task in tasks}
         remaining, interrupted = set(futures), False
         try:
@@ -69,7 +93,10 @@ class LocalPool:
                     _interrupt_workers(pool)
                     remaining = {future for future in remaining if not future.cancel()}
         finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+            if not kept or interrupted:
+                pool.shutdown(wait=True, cancel_futures=True)
+                if kept:
+                    self._pool, self._stop = None, None
         return interrupted
 
 

@@ -264,5 +264,35 @@ def synthesize(
                   f"over {record.time[-1] * 1e3:.3f} ms", highlight=False, soft_wrap=True)
 
 
+@app.command()
+@user_errors
+def diagnose(
+    config: Optional[Path] = ConfigArgument,
+    measured: Path = typer.Option(..., "--measured", help="Measured record: CSV (time + one column per sensor) or HDF5."),
+    overrides: List[str] = SetOption,
+    mapping: List[str] = typer.Option([], "--map", help="Map a column to a sensor: --map Weg=sealing_rod_displacement (repeatable)."),
+    candidates: Optional[str] = typer.Option(
+        None, "--candidates", help="Kinds of effect to try: clearance,friction,stiffness,restitution,drive,damping,mass (default all)."),
+    max_effects: int = typer.Option(1, "--max-effects", help="Add up to N effects, one per iteration (greedy)."),
+    out: Optional[Path] = typer.Option(None, "-o", "--out", help="Report folder (default: results/diagnose-<config>-<record>/)."),
+    lowpass: Optional[str] = typer.Option(None, "--lowpass", help="The bench's low-pass filter if known: 2kHz (default: estimated from the record)."),
+    workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes (default: all cores)."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Run the simulations on a Dask cluster: tcp://host:8786."),
+    fit_top: int = typer.Option(3, "--fit-top", help="Candidates fitted in full per iteration (the best of the screening)."),
+) -> None:
+    """Compare a model with measured data, name the missing effect, add it and show the gap shrink."""
+    from clearsim.diagnose.report import verdict, write_report
+    from clearsim.diagnose.workflow import DiagnoseRequest, diagnose as run_diagnosis
+    from clearsim.runner import BUNDLED_CONFIG
+
+    request = DiagnoseRequest(config or BUNDLED_CONFIG, measured, overrides, mapping, candidates, max_effects, out,
+                              workers, scheduler, lowpass, fit_top)
+    result = run_diagnosis(request, say=lambda text: console.print(text, highlight=False, soft_wrap=True))
+    written = write_report(result)
+    console.print(f"[bold]{escape(verdict(result))}[/]", soft_wrap=True)
+    console.print(f"{result.simulations} simulations in {result.wall_time:.0f} s; report: {written[2]}",
+                  highlight=False, soft_wrap=True)
+
+
 if __name__ == "__main__":
     app()

@@ -1,0 +1,238 @@
+"""Candidate effects: named, bounded, one-parameter changes of a mechanism document.
+
+A candidate knows its kind ("clearance", "friction", ...), its target (a joint, body or driver
+name, or None), its parameter with physical bounds, and how to write a value into a YAML
+document (a dict, edited in place). To add a kind, write one function `kind(mechanism, document)
+-> list[Candidate]` and register it in KINDS.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from clearsim.model.overrides import apply_overrides
+from clearsim.model.resolve import is_clearance_joint, resolve_clearance
+from clearsim.model.schema import Mechanism, StrokeMotion
+from clearsim.units import to_si
+
+FAR_ANCHOR = 1000.0  # m: a damper anchored this far along its line acts in a fixed direction
+
+
+@dataclass(frozen=True)
+class Candidate:
+    kind: str
+    target: str | None
+    parameter: str  # name of the fitted quantity, e.g. "clearance"
+    unit: str  # SI unit of the parameter ("" for a factor)
+    low: float
+    high: float
+    logarithmic: bool
+    current: float | None  # the parameter's value in the model as given (None: the effect is absent)
+    write: Callable[[dict, float], None]  # puts a value into a document
+    display_unit: tuple[str, float] = ("", 1.0)  # unit shown to engineers and the SI value of one of it
+
+    @property
+    def key(self) -> tuple[str, str | None, str]:
+        return self.kind, self.target, self.parameter
+
+    @property
+    def label(self) -> str:
+        where = f" in joint {self.target}" if self.kind in JOINT_KINDS else (f" of {self.target}" if self.target else "")
+        return f"{KIND_TITLES.get(self.kind, self.kind)}{where}" + (f" ({self.parameter})" if self.kind == "drive" else "")
+
+    def applied(self, document: dict, value: float) -> dict:
+        """A copy of the document with the parameter set to `value`."""
+        changed = copy.deepcopy(document)
+        self.write(changed, float(value))
+        return changed
+
+    def grid(self, points: int) -> np.ndarray:
+        """`points` values spread over the bounds (log-spaced for scale parameters), ends excluded."""
+        inner = np.linspace(0.0, 1.0, points + 2)[1:-1]
+        return self.from_unit(inner)
+
+    def from_unit(self, u) -> np.ndarray:
+        u = np.asarray(u, dtype=float)
+        if self.logarithmic:
+            return np.exp(np.log(self.low) + u * (np.log(self.high) - np.log(self.low)))
+        return self.low + u * (self.high - self.low)
+
+    def to_unit(self, value) -> np.ndarray:
+        value = np.asarray(value, dtype=float)
+        if self.logarithmic:
+            return (np.log(value) - np.log(self.low)) / (np.log(self.high) - np.log(self.low))
+        return (value - self.low) / (self.high - self.low)
+
+    def shown(self, value: float) -> str:
+        unit, scale = self.display_unit
+        return f"{value / scale:.3g}{' ' + unit if unit else ''}"
+
+
+KIND_TITLES = {"clearance": "clearance", "friction": "friction", "stiffness": "contact stiffness",
+               "restitution": "restitution", "drive": "drive", "damping": "viscous damping", "mass": "mass"}
+JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution"}
+
+
+def _set(document: dict, path: str, value) -> None:
+    """Write a value as `--set path=value` would (a clearance keeps the joint's bearing radius)."""
+    text = f"{path}={value!r}" if not isinstance(value, str) else f"{path}={value}"
+    _, problems = apply_overrides(document, [text], Mechanism)
+    if problems:
+        raise ValueError(f"{text}: {problems[0].message}")
+
+
+def _revolute(mechanism):
+    """Revolute joints that may get a clearance: not those a driver moves."""
+    driven = {d.joint for d in mechanism.drivers}
+    return [j for j in mechanism.joints if j.type == "revolute" and j.name not in driven]
+
+
+def _clearance_joints(mechanism):
+    return [j for j in _revolute(mechanism) if is_clearance_joint(j)]
+
+
+# --- one function per kind ------------------------------------------------------------------------
+
+CLEARANCE_BOUNDS = (2e-6, 0.5e-3)  # m: 2 µm (a tight fit) to 0.5 mm (a worn pin)
+DEFAULT_BEARING_RADIUS = 0.01  # m, given to a new clearance joint when the file knows none
+
+
+def clearance(mechanism, document) -> list[Candidate]:
+    """Radial clearance c of each revolute joint (an ideal one becomes a clearance joint)."""
+    needs_radius = mechanism.defaults.bearing_radius is None
+    out = []
+    for joint in _revolute(mechanism):
+        current = resolve_clearance(joint, mechanism.defaults).clearance if is_clearance_joint(joint) else None
+        radius_missing = needs_radius and joint.bearing_radius is None and joint.journal_radius is None
+
+        def write(doc, value, name=joint.name, add_radius=radius_missing):
+            if add_radius:
+                _set(doc, f"joints.{name}.bearing_radius", DEFAULT_BEARING_RADIUS)
+            _set(doc, f"joints.{name}.clearance", value)
+
+        out.append(Candidate("clearance", joint.name, "clearance", "m", *CLEARANCE_BOUNDS, True, current, write,
+                             ("mm", 1e-3)))
+    return out
+
+
+FRICTION_BOUNDS = (0.0, 0.5)
+
+
+def friction(mechanism, document) -> list[Candidate]:
+    """Dynamic friction coefficient μ_d of each clearance joint (μ_s keeps its ratio to μ_d)."""
+    out = []
+    for joint in _clearance_joints(mechanism):
+        p = resolve_clearance(joint, mechanism.defaults)
+        law = p.friction_law if p.friction_law != "none" else "coulomb"
+        ratio = p.mu_s / p.mu_d if p.friction_law == "stiction_step" and p.mu_d > 0 else 1.0
+        spec = {"stiction_step": {"v_s": p.v_low, "v_d": p.v_high}, "ambrosio": {"v_0": p.v_low, "v_1": p.v_high}}
+
+        def write(doc, value, name=joint.name, law=law, ratio=ratio, extra=spec.get(law, {})):
+            numbers = {"mu_d": value, **({"mu_s": value * ratio} if law == "stiction_step" else {}), **extra}
+            body = ", ".join(f"{k}: {v!r}" for k, v in numbers.items())
+            _set(doc, f"joints.{name}.friction", f"{{law: {law}, {body}}}")
+
+        current = p.mu_d if p.friction_law != "none" else None
+        out.append(Candidate("friction", joint.name, "mu_d", "", *FRICTION_BOUNDS, False, current, write))
+    return out
+
+
+def stiffness(mechanism, document) -> list[Candidate]:
+    """Contact stiffness K of each clearance joint, from 1/10 to 10 times its present value."""
+    out = []
+    for joint in _clearance_joints(mechanism):
+        k0 = resolve_clearance(joint, mechanism.defaults).stiffness
+
+        def write(doc, value, name=joint.name):
+            _set(doc, f"joints.{name}.contact.stiffness", value)
+
+        out.append(Candidate("stiffness", joint.name, "stiffness", "N/m^n", 0.1 * k0, 10.0 * k0, True, k0, write))
+    return out
+
+
+def restitution(mechanism, document) -> list[Candidate]:
+    """Coefficient of restitution c_e of each clearance joint, 0.3 … 1."""
+    out = []
+    for joint in _clearance_joints(mechanism):
+        c0 = resolve_clearance(joint, mechanism.defaults).restitution
+
+        def write(doc, value, name=joint.name):
+            _set(doc, f"joints.{name}.contact.restitution", value)
+
+        out.append(Candidate("restitution", joint.name, "restitution", "", 0.3, 1.0, False, c0, write))
+    return out
+
+
+LAG_BOUNDS = (5e-5, 10e-3)  # s
+STROKE_FACTOR_BOUNDS = (0.9, 1.1)
+
+
+def drive(mechanism, document) -> list[Candidate]:
+    """Per driver: the actuator's first-order lag τ, and for stroke laws a stroke error (factor)."""
+    out = []
+    for driver in mechanism.drivers:
+        def write_lag(doc, value, name=driver.name):
+            _set(doc, f"drivers.{name}.lag", value)
+
+        out.append(Candidate("drive", driver.name, "lag", "s", *LAG_BOUNDS, True, driver.lag or None, write_lag,
+                             ("ms", 1e-3)))
+        if isinstance(driver.motion, StrokeMotion):
+            written = driver.motion.stroke
+
+            def write_stroke(doc, value, name=driver.name, written=written):
+                kind = "length" if not str(written).strip().endswith(("deg", "rad")) else "angle"
+                _set(doc, f"drivers.{name}.motion.stroke", to_si(written, kind) * value)
+
+            out.append(Candidate("drive", driver.name, "stroke factor", "", *STROKE_FACTOR_BOUNDS, False, 1.0,
+                                 write_stroke))
+    return out
+
+
+def damping(mechanism, document) -> list[Candidate]:
+    """A viscous damper on the output body along the output direction (gas or oil damping)."""
+    sensors = {s.name: s for s in mechanism.sensors}
+    output = sensors.get(mechanism.output.velocity or mechanism.output.displacement or "")
+    if output is None or not hasattr(output, "direction"):
+        return []
+    body = next(b for b in mechanism.bodies if b.name == output.body)
+    where = np.asarray(body.position, float)
+    direction = np.asarray(output.direction, float) / np.linalg.norm(output.direction)
+    anchor = where + FAR_ANCHOR * direction
+    total_mass = sum(b.mass for b in mechanism.bodies)
+    scale = total_mass / mechanism.solver.t_end  # N·s/m: a damper that matters over the run
+
+    def write(doc, value):
+        forces = doc.setdefault("forces", []) or []
+        doc["forces"] = [f for f in forces if f.get("name") != "diagnose_damping"] + [{
+            "type": "spring_damper", "name": "diagnose_damping", "bodies": ["ground", body.name],
+            "at": [anchor.tolist(), where.tolist()], "damping": value}]
+
+    return [Candidate("damping", body.name, "damping", "N*s/m", 1e-3 * scale, 10.0 * scale, True, None, write,
+                      ("N·s/m", 1.0))]
+
+
+MASS_FACTOR_BOUNDS = (0.5, 2.0)
+
+
+def mass(mechanism, document) -> list[Candidate]:
+    """Mass (and inertia, in proportion) of each body, 0.5 … 2 times as written."""
+    out = []
+    for body in mechanism.bodies:
+        def write(doc, value, name=body.name, m0=body.mass, j0=body.inertia):
+            _set(doc, f"bodies.{name}.mass", m0 * value)
+            _set(doc, f"bodies.{name}.inertia", j0 * value)
+
+        out.append(Candidate("mass", body.name, "mass factor", "", *MASS_FACTOR_BOUNDS, True, 1.0, write))
+    return out
+
+
+KINDS: dict[str, Callable] = {"clearance": clearance, "friction": friction, "stiffness": stiffness,
+                              "restitution": restitution, "drive": drive, "damping": damping, "mass": mass}
+
+
+def candidates_for(mechanism, document: dict, kinds: list[str]) -> list[Candidate]:
+    return [c for kind in kinds for c in KINDS[kind](mechanism, document)]

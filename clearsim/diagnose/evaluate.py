@@ -1,0 +1,92 @@
+"""Model runs for the diagnosis, in parallel through the sweep executor, each run once.
+
+A model variant is a YAML document (dict). Its text is hashed into the file name under
+`<report>/runs/`, and the sweep worker reuses a complete file written from the same text, so a
+repeated evaluation (a scan point met again, a diagnosis run again) costs nothing.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+import yaml
+
+from clearsim.sweep.worker import COMPLETE, CaseTask, run_case
+
+
+@dataclass
+class Prediction:
+    """What a run predicts: all its sensors over its time grid; `error` when it failed."""
+
+    time: np.ndarray
+    sensors: dict[str, np.ndarray]
+    error: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return not self.error
+
+
+def document_text(document: dict) -> str:
+    return yaml.safe_dump(document, sort_keys=False, allow_unicode=True)
+
+
+def _read_sensors(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    with h5py.File(path, "r") as handle:
+        sensors = handle.get("sensors")
+        values = {name: np.asarray(sensors[name][()], float) for name in sensors} if sensors is not None else {}
+        return np.asarray(handle["time"][()], float), values
+
+
+class Evaluator:
+    """Runs documents on an executor (a LocalPool kept open, or a Dask cluster); counts what it ran."""
+
+    def __init__(self, folder: Path, config_name: str, base_dir: Path, executor, min_output_rate: float):
+        self.folder = Path(folder)
+        self.config_name = config_name
+        self.base_dir = Path(base_dir)
+        self.executor = executor
+        self.min_output_rate = min_output_rate
+        self.simulations = 0  # runs computed (not reused)
+        self._memory: dict[str, Prediction] = {}
+
+    def _prepared(self, document: dict) -> str:
+        solver = document.setdefault("solver", {})
+        rate = solver.get("output_rate")
+        if rate is None or _hertz(rate) < self.min_output_rate:
+            solver["output_rate"] = float(self.min_output_rate)
+        return document_text(document)
+
+    def evaluate(self, documents: list[dict]) -> list[Prediction]:
+        """Predictions for the documents, in order; the new ones run in parallel."""
+        texts = [self._prepared(copy.deepcopy(d)) for d in documents]
+        self.folder.mkdir(parents=True, exist_ok=True)
+        todo = {}
+        for text in texts:
+            digest = hashlib.sha256(text.encode()).hexdigest()[:16]
+            if digest not in self._memory and digest not in todo:
+                todo[digest] = CaseTask(digest, text, self.config_name, str(self.base_dir), (),
+                                        str(self.folder / f"{digest}.h5"))
+        outcomes = {}
+        if todo:
+            interrupted = self.executor.run(run_case, list(todo.values()), lambda o: outcomes.__setitem__(o.name, o))
+            if interrupted:
+                raise KeyboardInterrupt
+        for digest, outcome in outcomes.items():
+            self.simulations += int(outcome.ran)
+            if outcome.state == COMPLETE:
+                self._memory[digest] = Prediction(*_read_sensors(Path(todo[digest].output)))
+            else:
+                self._memory[digest] = Prediction(np.empty(0), {}, outcome.error or outcome.state)
+        return [self._memory[hashlib.sha256(t.encode()).hexdigest()[:16]] for t in texts]
+
+
+def _hertz(value) -> float:
+    from clearsim.units import to_si
+
+    return float(value) if isinstance(value, (int, float)) else to_si(str(value), "frequency")

@@ -1,0 +1,94 @@
+"""What engineers read off a record, measured beside modelled, and where the residual leaves the noise band."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.signal import savgol_filter
+
+from clearsim.diagnose.align import Record, SMOOTHER_ORDER, smoother_window
+
+START_FRACTION = 0.05  # a signal has started when it has moved 5 % of its range
+SETTLE_BAND = 0.02  # settled: within ±2 % of the range around the final value
+WINDOW_SECONDS = 1e-3  # moving RMS of the residual over 1 ms
+BAND = 3.0  # a window disagrees where the moving RMS exceeds 3 σ̂
+
+
+@dataclass(frozen=True)
+class Feature:
+    sensor: str
+    name: str
+    measured: float
+    model: float
+    unit: str
+
+    @property
+    def difference(self) -> float:
+        return self.measured - self.model
+
+
+def start_time(time: np.ndarray, values: np.ndarray) -> float:
+    """First time the signal has moved START_FRACTION of its range from its initial value."""
+    moved = np.abs(values - values[0]) >= START_FRACTION * np.ptp(values)
+    return float(time[np.argmax(moved)]) if np.any(moved) else np.nan
+
+
+def settling_time(time: np.ndarray, values: np.ndarray) -> float:
+    """Last time the signal is outside ±SETTLE_BAND of its range around its final value."""
+    outside = np.abs(values - values[-1]) > SETTLE_BAND * np.ptp(values)
+    return float(time[np.nonzero(outside)[0][-1]]) if np.any(outside) else float(time[0])
+
+
+def overshoot(values: np.ndarray) -> float:
+    """How far the signal goes beyond its final value, in the direction of travel, as a fraction of its range."""
+    travel = np.sign(values[-1] - values[0]) or 1.0
+    return float(max(0.0, np.max(travel * (values - values[-1]))) / (np.ptp(values) or 1.0))
+
+
+def shaking(values: np.ndarray, rate: float) -> float:
+    """RMS of the signal above the local cubic trend (the smoother of the noise estimate): high-frequency content."""
+    window = smoother_window(len(values))
+    if window <= SMOOTHER_ORDER + 1:
+        return 0.0
+    return float(np.sqrt(np.mean((values - savgol_filter(values, window, SMOOTHER_ORDER, mode="interp")) ** 2)))
+
+
+def features(record: Record, prediction: dict[str, np.ndarray], units: dict[str, str]) -> list[Feature]:
+    """Start, peak, end value, overshoot, settling and shaking of every sensor, measured vs model."""
+    out = []
+    for sensor, measured in record.values.items():
+        model, unit, t = prediction[sensor], units.get(sensor, ""), record.time
+        pairs = {
+            "start time": (start_time(t, measured), start_time(t, model), "s"),
+            "peak |value|": (float(np.max(np.abs(measured))), float(np.max(np.abs(model))), unit),
+            "end value": (float(np.mean(measured[-max(len(t) // 50, 1):])), float(np.mean(model[-max(len(t) // 50, 1):])), unit),
+            "overshoot": (overshoot(measured), overshoot(model), "of range"),
+            "settling time": (settling_time(t, measured), settling_time(t, model), "s"),
+            "shaking (RMS above trend)": (shaking(measured, record.rate), shaking(model, record.rate), unit),
+        }
+        out += [Feature(sensor, name, m, p, u) for name, (m, p, u) in pairs.items()]
+    return out
+
+
+@dataclass(frozen=True)
+class Window:
+    sensor: str
+    start: float
+    end: float
+    peak: float  # largest moving RMS in the window, in noise levels
+
+
+def disagreement_windows(record: Record, residual: dict[str, np.ndarray]) -> list[Window]:
+    """Time windows where the 1-ms moving RMS of the residual exceeds BAND noise levels."""
+    width = max(int(round(WINDOW_SECONDS * record.rate)), 3)
+    kernel = np.ones(width) / width
+    out = []
+    for sensor, r in residual.items():
+        level = np.sqrt(np.convolve(r ** 2, kernel, mode="same")) / record.noise[sensor].std
+        flagged = level > BAND
+        edges = np.diff(np.concatenate([[0], flagged.astype(int), [0]]))
+        for start, stop in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]):
+            out.append(Window(sensor, float(record.time[start]), float(record.time[stop - 1]),
+                              float(level[start:stop].max())))
+    return sorted(out, key=lambda w: -w.peak)

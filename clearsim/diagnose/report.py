@@ -1,0 +1,190 @@
+"""The diagnosis written down: diagnosis.json, report.md with figures, and the augmented model YAML.
+
+Nothing is overwritten silently: an earlier report's files are kept under numbered names.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from clearsim.diagnose.align import predict, residuals
+from clearsim.diagnose.evaluate import document_text
+from clearsim.diagnose.search import Scored
+from clearsim.diagnose.workflow import Diagnosis, effect_line
+from clearsim.io.hdf5 import keep_existing
+
+REPORT, JSON = "report.md", "diagnosis.json"
+
+
+def _effect(scored: Scored) -> dict:
+    c = scored.candidate
+    low, high = scored.interval
+    return {"kind": c.kind, "target": c.target, "parameters": {c.parameter: scored.best.value},
+            "interval": {c.parameter: [low, high]}, "unit": {c.parameter: c.unit},
+            "ambiguous_with": scored.ambiguous_with, "telling_sensor": scored.telling_sensor,
+            "delta_bic": scored.delta_bic, "gap": scored.best.fit.gap}
+
+
+def _ranking(scored: list[Scored]) -> list[dict]:
+    rows = []
+    for s in scored:
+        best = s.best
+        rows.append({"kind": s.candidate.kind, "target": s.candidate.target, "parameter": s.candidate.parameter,
+                     "value": best.value if best else None, "fitted": s.fitted,
+                     "chi_square": best.chi_square if best else None,
+                     "delta_bic": s.delta_bic if np.isfinite(s.delta_bic) else None,
+                     "gap": best.fit.gap if best else None, "runs": len(s.points),
+                     "failed_runs": sum(p.fit is None for p in s.points)})
+    return rows
+
+
+def diagnosis_document(d: Diagnosis) -> dict:
+    """The machine-readable diagnosis; `effects`, `gap_before`, `gap_after` and `gaps` are its stable core."""
+    return {
+        "config": str(d.request.config), "measured": str(d.request.measured), "overrides": list(d.request.overrides),
+        "effects": [_effect(s) for s in d.effects],
+        "gap_before": d.before.gap, "gap_after": d.after.gap,
+        "gaps": {s: {"before": d.before.gaps[s], "after": d.after.gaps[s]} for s in d.sensors},
+        "trigger_offset_s": {"before": d.before.offset, "after": d.after.offset},
+        "noise": {s: {"std": n.std, "effective_samples": n.effective_samples, "samples": n.samples}
+                  for s, n in d.record.noise.items()},
+        "comparison_lowpass_hz": d.record.cutoff,
+        "iterations": [{"gap": it.baseline.gap, "found": _effect(it.found) if it.found else None,
+                        "ranking": _ranking(it.ranked),
+                        "windows": [{"sensor": w.sensor, "start_s": w.start, "end_s": w.end, "peak_noise_levels": w.peak}
+                                    for w in it.windows]} for it in d.iterations],
+        "simulations": d.simulations, "wall_time_s": d.wall_time,
+    }
+
+
+def augmented_yaml(d: Diagnosis) -> str:
+    """The model with the effects found, as YAML, with a comment naming each one."""
+    lines = [f"# {Path(d.request.config).name} with the effects found by clearsim diagnose "
+             f"from {Path(d.request.measured).name}:"]
+    lines += [f"#   {i}. {effect_line(s, it.baseline)}" for i, (s, it) in
+              enumerate(((it.found, it) for it in d.iterations if it.found), start=1)] or ["#   (none)"]
+    if d.request.overrides:
+        lines.append(f"# starting model: --set {' '.join(d.request.overrides)}")
+    return "\n".join(lines) + "\n" + document_text(d.final)
+
+
+def write_report(d: Diagnosis, fmt: str = "png") -> list[Path]:
+    folder = d.folder
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    json_path = folder / JSON
+    keep_existing(json_path)
+    json_path.write_text(json.dumps(diagnosis_document(d), indent=2, default=_plain) + "\n", encoding="utf-8")
+    written.append(json_path)
+    model_path = folder / f"{Path(d.request.config).stem}.diagnosed.yaml"
+    keep_existing(model_path)
+    model_path.write_text(augmented_yaml(d), encoding="utf-8")
+    written.append(model_path)
+    figures = _figures(d, fmt)
+    report_path = folder / REPORT
+    keep_existing(report_path)
+    report_path.write_text(_markdown(d, figures, model_path), encoding="utf-8")
+    written += [report_path, *figures]
+    return written
+
+
+def _plain(value):
+    if isinstance(value, (np.floating, np.integer)):
+        return value.item()
+    raise TypeError(type(value))
+
+
+def verdict(d: Diagnosis) -> str:
+    if not d.effects:
+        return (f"no missing effect found: no candidate lowers the BIC by more than the significance margin; "
+                f"gap {d.before.gap:.3g}")
+    return "; ".join(f"missing effect: {effect_line(s, it.baseline)}" for it in d.iterations if (s := it.found))
+
+
+def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
+    out = [f"# Diagnosis of {Path(d.request.config).name} against {Path(d.request.measured).name}", "",
+           f"**{verdict(d)}**", "",
+           f"{d.simulations} simulations, {d.wall_time:.0f} s. Gap = RMS residual / noise level (docs/diagnose.md).", "",
+           "| sensor | noise σ̂ | n_eff / N | gap before | gap after |", "|---|---|---|---|---|"]
+    for s in d.sensors:
+        n = d.record.noise[s]
+        out.append(f"| {s} | {n.std:.3g} {d.units.get(s, '')} | {n.effective_samples:.0f} / {n.samples} | "
+                   f"{d.before.gaps[s]:.3g} | {d.after.gaps[s]:.3g} |")
+    out += [f"| combined | | | {d.before.gap:.3g} | {d.after.gap:.3g} |", "",
+            f"Trigger offset: {d.before.offset * 1e3:.3f} ms (fitted as a nuisance).", "",
+            "## Where the model and the record disagree (before)", "",
+            "| sensor | feature | measured | model | unit |", "|---|---|---|---|---|"]
+    out += [f"| {f.sensor} | {f.name} | {f.measured:.4g} | {f.model:.4g} | {f.unit} |" for f in d.iterations[0].features]
+    out += ["", "Windows where the 1-ms RMS residual exceeds 3 noise levels: "
+            + (", ".join(f"{w.sensor} {w.start * 1e3:.2f}–{w.end * 1e3:.2f} ms ({w.peak:.1f}σ̂)"
+                         for w in d.iterations[0].windows[:8]) or "none"), ""]
+    for number, it in enumerate(d.iterations, start=1):
+        out += [f"## Iteration {number}: candidates ranked", "",
+                "| candidate | parameter | best value | ΔBIC | gap | runs |", "|---|---|---|---|---|---|"]
+        for s in it.ranked:
+            best = s.best
+            value = s.candidate.shown(best.value) if best else "—"
+            delta = f"{s.delta_bic:.1f}" if np.isfinite(s.delta_bic) else "—"
+            gap = f"{best.fit.gap:.3g}" if best else "run failed"
+            out.append(f"| {s.candidate.label}{'' if s.fitted else ' (screened)'} | {s.candidate.parameter} | "
+                       f"{value} | {delta} | {gap} | {len(s.points)} |")
+        out.append("")
+    out += ["## Figures", ""] + [f"![{p.stem}]({p.name})" for p in figures]
+    out += ["", f"Augmented model: `{model_path.name}`.", ""]
+    return "\n".join(out)
+
+
+def _figures(d: Diagnosis, fmt: str) -> list[Path]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    paths = []
+    before = d.iterations[0].baseline_prediction
+    after = d.after_prediction
+    aligned_before = predict(d.record, before.time, before.sensors, d.before.offset)
+    aligned_after = predict(d.record, after.time, after.sensors, d.after.offset)
+    t = d.record.time * 1e3
+    fig, axes = plt.subplots(len(d.sensors), 2, figsize=(12, 3.2 * len(d.sensors)), squeeze=False)
+    res_before, res_after = residuals(d.record, aligned_before), residuals(d.record, aligned_after)
+    for row, s in enumerate(d.sensors):
+        left, right = axes[row]
+        left.plot(t, d.record.values[s], color="0.6", lw=0.8, label="measured")
+        left.plot(t, aligned_before[s], lw=1.0, label="model as given")
+        left.plot(t, aligned_after[s], lw=1.0, ls="--", label="with the effects found")
+        left.set_ylabel(f"{s} [{d.units.get(s, '')}]")
+        right.plot(t, res_before[s] / d.record.noise[s].std, lw=0.8, label=f"before (gap {d.before.gaps[s]:.3g})")
+        right.plot(t, res_after[s] / d.record.noise[s].std, lw=0.8, label=f"after (gap {d.after.gaps[s]:.3g})")
+        right.axhspan(-3, 3, color="0.9")
+        right.set_ylabel("residual / σ̂")
+        left.legend(fontsize=8), right.legend(fontsize=8)
+    for ax in axes[-1]:
+        ax.set_xlabel("time [ms]")
+    fig.tight_layout()
+    paths.append(_save(fig, d.folder / f"diagnose-comparison.{fmt}"))
+    fig, (rank_ax, gap_ax) = plt.subplots(1, 2, figsize=(12, 4))
+    ranked = [s for s in d.iterations[0].ranked if np.isfinite(s.delta_bic)][:12]
+    rank_ax.barh([s.candidate.label for s in ranked][::-1], [s.delta_bic for s in ranked][::-1])
+    rank_ax.axvline(-10, color="k", ls=":", lw=0.8)
+    rank_ax.set_xlabel("ΔBIC vs the model as given (below −10: significant)")
+    gaps = [d.before.gap] + [s.best.fit.gap for s in d.effects]
+    gap_ax.plot(range(len(gaps)), gaps, "o-")
+    gap_ax.set_xticks(range(len(gaps)), ["as given"] + [s.candidate.label for s in d.effects], rotation=15)
+    gap_ax.set_ylabel("combined gap")
+    gap_ax.axhline(1.0, color="0.5", ls=":")
+    fig.tight_layout()
+    paths.append(_save(fig, d.folder / f"diagnose-ranking.{fmt}"))
+    return paths
+
+
+def _save(fig, path: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    keep_existing(path)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,171 @@
+"""Fitting and ranking candidate effects (docs/diagnose.md §"Fit and rank").
+
+Each candidate has one parameter. The cost (χ² at the best trigger offset) of a clearance is not
+smooth — impacts come and go as c changes — so the fit is a search on a grid that is refined
+around its best point, never a gradient method:
+
+    screen   two values per candidate (at 30 % and 75 % of its range): is it visible at all, and how good?
+    scan     six more values over the range for the most promising candidates
+    zoom     four, then two values between the best point and its neighbours
+
+Candidates are ranked by the Bayesian information criterion BIC = χ²_min + k ln n_eff (k = 1 fitted
+parameter; the trigger offset is fitted in every model alike), so a candidate must lower χ² by more
+than ln n_eff + SIGNIFICANCE to count as found: noise alone does not pass.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from clearsim.diagnose.align import Fit, Record, fit_offset
+from clearsim.diagnose.candidates import Candidate
+from clearsim.diagnose.evaluate import Evaluator, Prediction
+
+SCREEN_POINTS = (0.3, 0.75)  # of the range (in log units for scale parameters)
+SCAN_POINTS = 6
+ZOOM_ROUNDS = (4, 2)
+SIGNIFICANCE = 10.0  # ΔBIC below −10: "very strong" evidence (Kass & Raftery 1995)
+TIE = 6.0  # BIC within 6 of the best: the data do not tell the two apart
+VISIBLE = 1.0  # |Δχ²| below 1 at both screening values: the sensors do not see the candidate
+
+
+@dataclass
+class Point:
+    value: float
+    fit: Fit | None  # None: the run failed
+    prediction: Prediction
+    error: str = ""
+
+    @property
+    def chi_square(self) -> float:
+        return self.fit.chi_square if self.fit is not None else np.inf
+
+
+@dataclass
+class Scored:
+    """A candidate's evaluations and verdict."""
+
+    candidate: Candidate
+    points: list[Point] = field(default_factory=list)
+    fitted: bool = False  # scanned and zoomed, not only screened
+    bic: float = np.inf
+    delta_bic: float = np.inf  # BIC − BIC of the baseline
+    interval: tuple[float, float] | None = None
+    ambiguous_with: list[str] = field(default_factory=list)
+    telling_sensor: str | None = None
+
+    @property
+    def best(self) -> Point | None:
+        finished = [p for p in self.points if p.fit is not None]
+        return min(finished, key=lambda p: p.chi_square) if finished else None
+
+    @property
+    def visible(self) -> bool:
+        return self.best is not None
+
+
+def evaluate_points(evaluator: Evaluator, record: Record, sensors: list[str],
+                    jobs: list[tuple[Scored, float]], document: dict) -> None:
+    """Run candidate values (all at once, in parallel) and append the fitted points."""
+    predictions = evaluator.evaluate([scored.candidate.applied(document, value) for scored, value in jobs])
+    for (scored, value), prediction in zip(jobs, predictions):
+        scored.points.append(score_point(record, sensors, value, prediction))
+
+
+def score_point(record: Record, sensors: list[str], value: float, prediction: Prediction) -> Point:
+    if not prediction.ok:
+        return Point(value, None, prediction, prediction.error)
+    fit = fit_offset(record, prediction.time, {s: prediction.sensors[s] for s in sensors})
+    return Point(value, fit, prediction)
+
+
+def screen(evaluator, record, sensors, candidates: list[Candidate], document) -> list[Scored]:
+    scored = [Scored(c) for c in candidates]
+    evaluate_points(evaluator, record, sensors, [(s, v) for s in scored for v in s.candidate.from_unit(SCREEN_POINTS)],
+                    document)
+    return scored
+
+
+def seen_by_sensors(scored: Scored, baseline: float) -> bool:
+    return any(p.fit is not None and abs(p.chi_square - baseline) > VISIBLE for p in scored.points)
+
+
+def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
+    """Scan, then zoom twice around each candidate's best point (each round one parallel batch)."""
+    evaluate_points(evaluator, record, sensors, [(s, v) for s in chosen for v in s.candidate.grid(SCAN_POINTS)], document)
+    for count in ZOOM_ROUNDS:
+        evaluate_points(evaluator, record, sensors, [(s, v) for s in chosen for v in _zoom(s, count)], document)
+    for s in chosen:
+        s.fitted = True
+
+
+def _zoom(scored: Scored, count: int) -> list[float]:
+    """`count` new values between the best point and its neighbours (in the candidate's unit range)."""
+    units = np.sort(np.unique(scored.candidate.to_unit([p.value for p in scored.points])))
+    best = float(scored.candidate.to_unit(scored.best.value)) if scored.best else 0.5
+    k = int(np.argmin(np.abs(units - best)))
+    below = units[k - 1] if k > 0 else 0.0
+    above = units[k + 1] if k + 1 < len(units) else 1.0
+    half = count // 2
+    new = [best - (best - below) * (i + 1) / (half + 1) for i in range(half)]
+    new += [best + (above - best) * (i + 1) / (half + 1) for i in range(count - half)]
+    return [float(scored.candidate.from_unit(u)) for u in new if 0.0 <= u <= 1.0]
+
+
+def judge(scored: list[Scored], baseline: Fit, record: Record) -> list[Scored]:
+    """BIC, ΔBIC, interval for every candidate; ranked best first; ties marked on the best."""
+    penalty = np.log(max(record.effective_samples, 2.0))
+    for s in scored:
+        if s.best is None:
+            continue
+        s.bic = s.best.chi_square + penalty
+        s.delta_bic = s.bic - baseline.chi_square
+        s.interval = interval(s, record)
+    ranked = sorted(scored, key=lambda s: (not s.fitted, s.bic))
+    return ranked
+
+
+def interval(scored: Scored, record: Record) -> tuple[float, float]:
+    """Values whose χ² is within Δ = max(1, χ²_min/n_eff) of the best, widened halfway to the next
+    evaluated values outside (a profile interval on the evaluated grid; ~68 % for smooth costs)."""
+    finished = sorted((p for p in scored.points if p.fit is not None), key=lambda p: p.value)
+    values = np.array([p.value for p in finished])
+    chi = np.array([p.chi_square for p in finished])
+    best = float(chi.min())
+    allowance = max(1.0, best / max(record.effective_samples, 1.0))
+    inside = np.nonzero(chi <= best + allowance)[0]
+    lo, hi = inside.min(), inside.max()
+    units = scored.candidate.to_unit(values)
+    low_u = 0.5 * (units[lo] + units[lo - 1]) if lo > 0 else 0.0
+    high_u = 0.5 * (units[hi] + units[hi + 1]) if hi + 1 < len(units) else 1.0
+    return float(scored.candidate.from_unit(low_u)), float(scored.candidate.from_unit(high_u))
+
+
+def mark_ties(ranked: list[Scored], all_sensors_scale: dict[str, float]) -> None:
+    """On the winner: the candidates whose BIC is within TIE, and the sensor that would tell them apart."""
+    if not ranked or ranked[0].best is None:
+        return
+    winner = ranked[0]
+    ties = [s for s in ranked[1:] if s.fitted and s.best is not None and s.bic - winner.bic <= TIE]
+    winner.ambiguous_with = [s.candidate.label for s in ties]
+    if ties:
+        winner.telling_sensor = telling_sensor(winner.best.prediction, [s.best.prediction for s in ties],
+                                               all_sensors_scale)
+
+
+def telling_sensor(first: Prediction, others: list[Prediction], scale: dict[str, float]) -> str | None:
+    """The model sensor on which the tied models differ most (RMS difference over the sensor's range)."""
+    best_name, best_score = None, 0.0
+    for name, values in first.sensors.items():
+        if not scale.get(name):
+            continue
+        for other in others:
+            if name not in other.sensors:
+                continue
+            difference = np.interp(first.time, other.time, other.sensors[name]) - values
+            score = float(np.sqrt(np.mean(difference ** 2)) / scale[name])
+            if score > best_score:
+                best_name, best_score = name, score
+    return best_name

@@ -1,0 +1,214 @@
+"""`clearsim diagnose`: align, locate, fit candidate effects, name the missing one, add it, repeat.
+
+    diagnosis = diagnose(DiagnoseRequest(config, measured, max_effects=2), say=print)
+
+Greedy forward selection: each iteration fits every candidate effect to the record on top of the
+model as it stands (the original plus the effects found so far), keeps the best one if its BIC
+beats the model's by SIGNIFICANCE, and stops when none does or `max_effects` are found.
+"""
+
+from __future__ import annotations
+
+import time as clock
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import yaml
+
+from clearsim.diagnose.align import Fit, Record, predict, prepare_record, residuals
+from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for
+from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
+from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
+from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
+from clearsim.diagnose.search import SIGNIFICANCE, Scored, judge, mark_ties, refine, score_point, screen, seen_by_sensors
+from clearsim.errors import ClearsimError, did_you_mean
+from clearsim.model.loader import load_mechanism, load_mechanism_text
+from clearsim.units import UnitError, to_si
+
+RESULTS = Path("results")
+FIT_TOP = 3
+
+
+class DiagnoseError(ClearsimError):
+    """A diagnosis that cannot start or continue (bad option, a model that does not run)."""
+
+
+@dataclass
+class DiagnoseRequest:
+    config: Path
+    measured: Path
+    overrides: list[str] = field(default_factory=list)
+    mapping: list[str] = field(default_factory=list)  # column=sensor
+    candidates: str | None = None  # "clearance,friction": kinds to try (default all)
+    max_effects: int = 1
+    out: Path | None = None
+    workers: int | None = None
+    scheduler: str | None = None
+    lowpass: str | None = None  # the bench's filter if known
+    fit_top: int = FIT_TOP
+
+
+@dataclass
+class Iteration:
+    baseline: Fit
+    baseline_prediction: Prediction
+    ranked: list[Scored]
+    found: Scored | None
+    features: list[Feature]
+    windows: list[Window]
+
+
+@dataclass
+class Diagnosis:
+    request: DiagnoseRequest
+    folder: Path
+    measured: MeasuredData
+    record: Record
+    sensors: list[str]
+    original: dict  # the document as given (with --set)
+    final: dict  # with the effects found
+    iterations: list[Iteration]
+    simulations: int
+    wall_time: float
+    units: dict
+
+    @property
+    def effects(self) -> list[Scored]:
+        return [it.found for it in self.iterations if it.found is not None]
+
+    @property
+    def before(self) -> Fit:
+        return self.iterations[0].baseline
+
+    @property
+    def after(self) -> Fit:
+        found = self.effects
+        return found[-1].best.fit if found else self.before
+
+    @property
+    def after_prediction(self) -> Prediction:
+        found = self.effects
+        return found[-1].best.prediction if found else self.iterations[0].baseline_prediction
+
+
+def chosen_kinds(text: str | None) -> list[str]:
+    if not text:
+        return list(KINDS)
+    kinds = [k.strip() for k in text.split(",") if k.strip()]
+    for kind in kinds:
+        if kind not in KINDS:
+            raise DiagnoseError(f"--candidates: unknown kind '{kind}'{did_you_mean(kind, KINDS)} "
+                                f"(kinds: {', '.join(KINDS)})")
+    return kinds
+
+
+def _cutoff(text: str | None) -> float | None:
+    if text is None:
+        return None
+    try:
+        value = to_si(text, "frequency")
+    except UnitError as exc:
+        raise DiagnoseError(f"--lowpass {text!r}: {exc}") from None
+    if value <= 0:
+        raise DiagnoseError(f"--lowpass {text!r}: the cut-off must be positive, e.g. --lowpass 2kHz")
+    return value
+
+
+def _executor(request: DiagnoseRequest):
+    from clearsim.sweep import DaskCluster, LocalPool
+
+    if request.scheduler:
+        executor = DaskCluster(request.scheduler, request.workers)
+        executor.connect()
+        return executor
+    return LocalPool(request.workers).open()
+
+
+def default_folder(request: DiagnoseRequest) -> Path:
+    return RESULTS / f"diagnose-{Path(request.config).stem}-{Path(request.measured).stem}"
+
+
+def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text: None) -> Diagnosis:
+    """The whole workflow; every input problem is a ClearsimError raised before any run."""
+    started = clock.perf_counter()
+    if request.max_effects < 1:
+        raise DiagnoseError(f"--max-effects must be at least 1, got {request.max_effects}")
+    kinds = chosen_kinds(request.candidates)
+    cutoff = _cutoff(request.lowpass)
+    loaded = load_mechanism(request.config, request.overrides)
+    measured = read_measured(request.measured, model_sensor_units(loaded.mechanism), parse_mapping(request.mapping))
+    sensors = list(measured.values)
+    record = prepare_record(measured.time, measured.values, cutoff)
+    units = model_sensor_units(loaded.mechanism)
+    say(_record_line(record))
+    document = yaml.safe_load(loaded.resolved_yaml)
+    original = document
+    folder = Path(request.out) if request.out else default_folder(request)
+    executor = _executor(request)
+    evaluator = Evaluator(folder / "runs", str(request.config), Path(request.config).parent, executor, record.rate)
+    iterations: list[Iteration] = []
+    try:
+        found_keys: set = set()
+        for number in range(1, request.max_effects + 1):
+            iteration = _iterate(evaluator, record, sensors, document, kinds, found_keys, units, request, number, say)
+            iterations.append(iteration)
+            if iteration.found is None:
+                break
+            found_keys.add(iteration.found.candidate.key)
+            document = iteration.found.candidate.applied(document, iteration.found.best.value)
+    finally:
+        executor.close() if hasattr(executor, "close") else None
+    return Diagnosis(request, folder, measured, record, sensors, original, document, iterations,
+                     evaluator.simulations, clock.perf_counter() - started, units)
+
+
+def _record_line(record: Record) -> str:
+    parts = [f"{s}: σ̂ = {n.std:.3g}, n_eff = {n.effective_samples:.0f} of {n.samples}" for s, n in record.noise.items()]
+    band = f"; comparison low-pass {record.cutoff:.0f} Hz" if record.cutoff else ""
+    return f"record: {len(record.time)} samples at {record.rate:.0f} Hz{band}; " + "; ".join(parts)
+
+
+def _mechanism(document: dict, request: DiagnoseRequest):
+    return load_mechanism_text(document_text(document), str(request.config), (), Path(request.config).parent).mechanism
+
+
+def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, request, number, say) -> Iteration:
+    base_prediction = evaluator.evaluate([document])[0]
+    if not base_prediction.ok:
+        raise DiagnoseError(f"{request.config}: the model does not run to the end ({base_prediction.error}); "
+                            "fix it with `clearsim run` first")
+    baseline = score_point(record, sensors, 0.0, base_prediction).fit
+    aligned = predict(record, base_prediction.time, {s: base_prediction.sensors[s] for s in sensors}, baseline.offset)
+    found_features = features(record, aligned, units)
+    windows = disagreement_windows(record, residuals(record, aligned))
+    say(f"iteration {number}: gap {baseline.gap:.3g} (trigger offset {baseline.offset * 1e3:.3f} ms), "
+        f"{len(windows)} window(s) outside the noise band")
+    candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds) if c.key not in found_keys]
+    scored = screen(evaluator, record, sensors, candidates, document)
+    visible = [s for s in scored if seen_by_sensors(s, baseline.chi_square)]
+    chosen = sorted(visible, key=lambda s: s.best.chi_square)[:request.fit_top]
+    say(f"  screened {len(candidates)} candidates ({len(visible)} visible to the sensors); fitting "
+        + ", ".join(s.candidate.label for s in chosen))
+    refine(evaluator, record, sensors, chosen, document)
+    ranked = judge(scored, baseline, record)
+    winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
+    if winner is not None:
+        mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
+        say(f"  found: {effect_line(winner, baseline)}")
+    else:
+        say("  no candidate beats the model significantly")
+    return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
+
+
+def effect_line(scored: Scored, baseline: Fit) -> str:
+    """'clearance in joint B, clearance = 0.082 mm (0.071–0.094 mm); gap 14.2 → 1.3 (−91%)'."""
+    c: Candidate = scored.candidate
+    best = scored.best
+    low, high = scored.interval
+    change = (best.fit.gap - baseline.gap) / baseline.gap if baseline.gap > 0 else 0.0
+    tie = f"; fits as well: {', '.join(scored.ambiguous_with)}" if scored.ambiguous_with else ""
+    tell = f" (tell apart with sensor {scored.telling_sensor})" if scored.telling_sensor else ""
+    return (f"{c.label}, {c.parameter} = {c.shown(best.value)} ({c.shown(low)}–{c.shown(high)}); "
+            f"gap {baseline.gap:.3g} → {best.fit.gap:.3g} ({change:+.0%}){tie}{tell}")

@@ -19,11 +19,12 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.signal import butter, savgol_filter, sosfiltfilt, welch
 
-SMOOTHER_ORDER = 3
+SMOOTHER_ORDER = 5
 SMOOTHER_CUTOFF = 1.0 / 40.0  # of the sampling rate: the local cubic follows the signal below it
 WELCH_SEGMENT = 256
 PASSED = 0.8  # the smoother's high-pass passes at least 80 % of the power: noise seen there is whole
 FLOOR_BINS = 5
+FLAT_PART = 0.6  # of the bandwidth: below it a bench filter has not started to roll off
 LINE_FACTOR = 3.0  # a spectral bin above 3× the floor holds signal (a Welch bin of noise rarely reaches it)
 COMPARISON_FILTER_ORDER = 4
 BANDWIDTH_DROP = 0.1  # the bench bandwidth ends where the noise floor has fallen to 10 % of its level
@@ -98,12 +99,17 @@ def equivalent_bandwidth(cutoff: float) -> float:
 
 
 def _floor_level(frequencies: np.ndarray, noise: np.ndarray, valid: np.ndarray) -> float:
-    """The flat noise floor: the median density over the passband, found in two rounds (the lowest
-    valid bins give the band, the band gives the level)."""
+    """The flat noise floor: the mean density over the flat part of the passband (up to FLAT_PART of
+    the bandwidth), spectral lines above LINE_FACTOR × the median left out. Two rounds: the lowest
+    valid bins give the bandwidth, the bandwidth gives the flat part."""
     first = np.nonzero(valid)[0][:FLOOR_BINS]
-    level = float(np.median(noise[first]))
-    band = valid & (frequencies <= (_bandwidth(frequencies, noise, level) or frequencies[-1]))
-    return float(np.median(noise[band])) if np.any(band) else level
+    bandwidth = _bandwidth(frequencies, noise, float(np.median(noise[first])))
+    flat = valid & (frequencies <= FLAT_PART * (bandwidth or frequencies[-1] / FLAT_PART))
+    if not np.any(flat):
+        flat = valid
+    typical = float(np.median(noise[flat]))
+    kept = noise[flat][noise[flat] <= LINE_FACTOR * typical]
+    return float(np.mean(kept)) if len(kept) else typical
 
 
 def _bandwidth(frequencies: np.ndarray, noise: np.ndarray, level: float) -> float | None:

@@ -29,6 +29,7 @@ from clearsim.units import UnitError, to_si
 
 RESULTS = Path("results")
 FIT_TOP = 3
+MIN_SAMPLES = 200  # the noise spectrum and the comparison filter need a few hundred samples
 
 
 class DiagnoseError(ClearsimError):
@@ -140,6 +141,9 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
     loaded = load_mechanism(request.config, request.overrides)
     measured = read_measured(request.measured, model_sensor_units(loaded.mechanism), parse_mapping(request.mapping))
     sensors = list(measured.values)
+    if len(measured.time) < MIN_SAMPLES:
+        raise DiagnoseError(f"{request.measured}: only {len(measured.time)} samples; diagnosing needs at least "
+                            f"{MIN_SAMPLES} (record the whole motion, at a few kHz or more)")
     record = prepare_record(measured.time, measured.values, cutoff)
     units = model_sensor_units(loaded.mechanism)
     say(_record_line(record))

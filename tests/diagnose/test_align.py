@@ -1,0 +1,54 @@
+"""The data-only arithmetic of the diagnosis: noise level, effective samples, trigger offset, gap."""
+
+import numpy as np
+import pytest
+from scipy.signal import butter, sosfiltfilt
+
+from clearsim.diagnose.align import equivalent_bandwidth, estimate_noise, fit_offset, prepare_record
+from clearsim.physics.motion import lagged, stroke_law
+
+RATE = 15_000.0
+TIME = np.arange(1276) / RATE
+STROKE = 0.2 * (TIME / 0.085) ** 2 * (3 - 2 * TIME / 0.085)
+
+
+def filtered_noise(std, cutoff, seed):
+    noise = np.random.default_rng(seed).normal(0.0, std, len(TIME))
+    return sosfiltfilt(butter(4, cutoff, fs=RATE, output="sos"), noise) if cutoff else noise
+
+
+@pytest.mark.parametrize("cutoff", [None, 4000.0, 2000.0, 1000.0])
+def test_noise_level_and_effective_samples_of_a_smooth_stroke_with_noise(cutoff):
+    for seed in range(3):
+        noise = filtered_noise(2e-3, cutoff, seed)
+        estimate = estimate_noise(STROKE + noise, RATE)
+        assert estimate.std == pytest.approx(np.std(noise), rel=0.15)
+        expected = 1.0 if cutoff is None else 2.0 * equivalent_bandwidth(cutoff) / RATE
+        assert estimate.effective_samples / estimate.samples == pytest.approx(expected, rel=0.35)
+        if cutoff is not None:
+            assert estimate.bandwidth == pytest.approx(cutoff, rel=0.3)
+
+
+def test_the_trigger_offset_of_a_shifted_record_is_recovered_to_a_tenth_of_a_sample():
+    offset = 0.7e-3
+    model_time = np.linspace(0.0, 0.085, 8501)
+    model = 0.2 * (model_time / 0.085) ** 2 * (3 - 2 * model_time / 0.085)
+    measured = np.interp(TIME - offset, model_time, model) + filtered_noise(1e-4, 2000.0, 7)
+    record = prepare_record(TIME, {"x": measured})
+    fit = fit_offset(record, model_time, {"x": model})
+    assert abs(fit.offset - offset) < 0.1 / RATE
+    assert fit.gap == pytest.approx(1.0, abs=0.2)  # the right model is explained down to the noise
+    wrong = fit_offset(record, model_time, {"x": 1.01 * model})
+    assert wrong.gap > 5.0
+
+
+def test_the_lagged_stroke_law_solves_the_first_order_lag():
+    from scipy.integrate import solve_ivp
+
+    law, lag = stroke_law(-0.23, 0.085), 3e-3
+    seen = lagged(law, lag)
+    t = np.linspace(0.0, 0.2, 4001)
+    reference = solve_ivp(lambda tt, y: (law(np.array([tt]))[0] - y) / lag, (0.0, 0.2), [0.0], t_eval=t,
+                          rtol=1e-11, atol=1e-14, max_step=1e-4).y[0]
+    assert np.max(np.abs(seen(t) - reference)) < 1e-7 * 0.23
+    assert seen(np.array([-1.0]))[0] == 0.0 and seen(np.array([10.0]))[0] == pytest.approx(-0.23, abs=1e-12)

@@ -1,0 +1,144 @@
+"""`clearsim diagnose` end to end: an effect hidden in synthetic data is named, fitted and added.
+
+The data come from `clearsim synthesize` with the effect set by --set; the model given to diagnose
+lacks it. CI-sized: the slider-crank over one crank revolution.
+"""
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from clearsim.cli import app
+from clearsim.model.loader import load_mechanism
+
+CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
+SLIDER_CRANK = str(CONFIGS / "slider_crank_flores.yaml")
+IDEAL = ["--set", "joints.slider_pin.clearance=0"]
+SENSORS = "slider_displacement,slider_velocity"
+BENCH = ["--rate", "50kHz", "--noise", "0.5%", "--lowpass", "10kHz", "--trigger-offset", "0.1ms"]
+runner = CliRunner()
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def synthesize(out: Path, *sets: str, seed: int = 3) -> Path:
+    options = [part for s in sets for part in ("--set", s)]
+    result = invoke("synthesize", SLIDER_CRANK, *IDEAL, *options, "--sensors", SENSORS, *BENCH, "--seed", seed, "-o", out)
+    assert result.exit_code == 0, result.output
+    return out
+
+
+def diagnose(record: Path, out: Path, *options: str) -> dict:
+    result = invoke("diagnose", SLIDER_CRANK, *IDEAL, "--measured", record, "-o", out, "--workers", 2, *options)
+    assert result.exit_code == 0, result.output
+    return json.loads((out / "diagnosis.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def hidden_clearance(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("clearance")
+    record = synthesize(folder / "bench.csv", "joints.slider_pin.clearance=0.2mm")
+    return folder, diagnose(record, folder / "report", "--candidates", "clearance,drive,mass")
+
+
+def test_a_hidden_clearance_is_named_fitted_and_closes_the_gap(hidden_clearance):
+    folder, found = hidden_clearance
+    assert len(found["effects"]) == 1
+    effect = found["effects"][0]
+    assert effect["kind"] == "clearance"
+    named = {effect["target"], *[label.split("joint ")[-1] for label in effect["ambiguous_with"]]}
+    assert "slider_pin" in named
+    if effect["target"] == "slider_pin":
+        assert effect["parameters"]["clearance"] == pytest.approx(0.2e-3, rel=0.3)
+    assert found["gap_after"] < 0.6 * found["gap_before"]
+    assert abs(found["trigger_offset_s"]["before"] - 0.1e-3) < 0.05e-3
+
+
+def test_the_report_and_the_augmented_model(hidden_clearance):
+    folder, found = hidden_clearance
+    report = folder / "report"
+    text = (report / "report.md").read_text()
+    assert "missing effect: clearance" in text and "diagnose-comparison.png" in text
+    assert (report / "diagnose-comparison.png").stat().st_size > 10_000
+    augmented = report / "slider_crank_flores.diagnosed.yaml"
+    assert augmented.read_text().startswith("# slider_crank_flores.yaml with the effects found")
+    mechanism = load_mechanism(augmented).mechanism  # a valid mechanism file, with the clearance added
+    joint = next(j for j in mechanism.joints if j.name == found["effects"][0]["target"])
+    assert joint.clearance == pytest.approx(found["effects"][0]["parameters"]["clearance"])
+
+
+def test_noise_alone_finds_no_effect(tmp_path):
+    record = synthesize(tmp_path / "bench.csv", seed=11)
+    found = diagnose(record, tmp_path / "report", "--candidates", "clearance,drive")
+    assert found["effects"] == []
+    assert found["gap_before"] == pytest.approx(1.0, abs=0.35)
+    assert all(row["delta_bic"] is None or row["delta_bic"] > -10 for row in found["iterations"][0]["ranking"])
+
+
+def test_an_existing_report_is_kept(hidden_clearance, tmp_path):
+    folder, _ = hidden_clearance
+    report = folder / "report"
+    before = (report / "diagnosis.json").read_text()
+    result = invoke("diagnose", SLIDER_CRANK, *IDEAL, "--measured", folder / "bench.csv", "-o", report,
+                    "--candidates", "clearance", "--fit-top", "1")
+    assert result.exit_code == 0, result.output
+    assert (report / "diagnosis.1.json").read_text() == before  # the earlier one, renamed
+
+
+@pytest.mark.parametrize("problem, content, message", [
+    ("no sensor column", "time [ms],slider_displacment [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(300)),
+     "did you mean 'slider_displacement'"),
+    ("no time column", "t [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(300)),
+     "no time column"),
+    ("time going back", "time [ms],slider_displacement [mm]\n" + "".join(f"{(k if k != 10 else 3) * 0.02},{k}\n" for k in range(30)),
+     "does not increase"),
+    ("NaN", "time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{'nan' if k == 5 else k}\n" for k in range(30)),
+     "not a finite number"),
+    ("wrong unit", "time [ms],slider_displacement [deg]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(30)),
+     "does not fit"),
+    ("too short to read", "time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(5)),
+     "at least"),
+    ("too short to diagnose", "time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(50)),
+     "diagnosing needs at least"),
+])
+def test_bad_measured_data_is_one_message_and_exit_code_2(tmp_path, problem, content, message):
+    record = tmp_path / "bench.csv"
+    record.write_text(content)
+    result = invoke("diagnose", SLIDER_CRANK, *IDEAL, "--measured", record, "-o", tmp_path / "report")
+    assert result.exit_code == 2, (problem, result.output)
+    assert "bench.csv" in result.output and message in result.output and "Traceback" not in result.output
+    assert not (tmp_path / "report" / "diagnosis.json").exists()
+
+
+@pytest.mark.parametrize("options, message", [
+    (["--candidates", "clearence"], "did you mean 'clearance'"),
+    (["--max-effects", "0"], "--max-effects"),
+    (["--lowpass", "2 kg"], "--lowpass"),
+])
+def test_bad_options_are_one_message_and_exit_code_2(tmp_path, options, message):
+    record = tmp_path / "bench.csv"
+    record.write_text("time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(300)))
+    result = invoke("diagnose", SLIDER_CRANK, *IDEAL, "--measured", record, *options)
+    assert result.exit_code == 2
+    assert message in result.output
+
+
+def test_candidate_documents_are_valid_mechanisms():
+    """Every candidate of every kind writes a value that loads (no schema or reference error)."""
+    from clearsim.diagnose.candidates import KINDS, candidates_for
+    from clearsim.diagnose.evaluate import document_text
+    from clearsim.model.loader import load_mechanism_text
+
+    loaded = load_mechanism(str(CONFIGS / "uhv_breaker.yaml"))
+    document = yaml.safe_load(loaded.resolved_yaml)
+    candidates = candidates_for(loaded.mechanism, document, list(KINDS))
+    assert {c.kind for c in candidates} == set(KINDS)
+    for candidate in candidates:
+        for value in (candidate.low, candidate.high):
+            load_mechanism_text(document_text(candidate.applied(document, value)), "candidate", (), CONFIGS)
+    assert not any(c.target == "hydraulic_drive" and c.kind == "clearance" for c in candidates)

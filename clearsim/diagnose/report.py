@@ -22,22 +22,24 @@ REPORT, JSON = "report.md", "diagnosis.json"
 def _effect(scored: Scored) -> dict:
     c = scored.candidate
     low, high = scored.interval
-    return {"kind": c.kind, "target": c.target, "parameters": {c.parameter: scored.best.value},
+    return {"kind": c.kind, "target": c.target, "parameters": {c.parameter: scored.estimate.value},
             "interval": {c.parameter: [low, high]}, "unit": {c.parameter: c.unit},
             "ambiguous_with": scored.ambiguous_with, "telling_sensor": scored.telling_sensor,
-            "delta_bic": scored.delta_bic, "gap": scored.best.fit.gap}
+            "delta_bic": scored.delta_bic, "gap": scored.estimate.fit.gap}
 
 
 def _ranking(scored: list[Scored]) -> list[dict]:
     rows = []
     for s in scored:
-        best = s.best
+        best = s.estimate
         rows.append({"kind": s.candidate.kind, "target": s.candidate.target, "parameter": s.candidate.parameter,
                      "value": best.value if best else None, "fitted": s.fitted,
                      "chi_square": best.chi_square if best else None,
                      "delta_bic": s.delta_bic if np.isfinite(s.delta_bic) else None,
                      "gap": best.fit.gap if best else None, "runs": len(s.points),
-                     "failed_runs": sum(p.fit is None for p in s.points)})
+                     "failed_runs": sum(p.fit is None for p in s.points),
+                     "profile": [[p.value, p.chi_square if p.fit is not None else None]
+                                 for p in sorted(s.points, key=lambda p: p.value)]})
     return rows
 
 
@@ -125,7 +127,7 @@ def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
         out += [f"## Iteration {number}: candidates ranked", "",
                 "| candidate | parameter | best value | ΔBIC | gap | runs |", "|---|---|---|---|---|---|"]
         for s in it.ranked:
-            best = s.best
+            best = s.estimate
             value = s.candidate.shown(best.value) if best else "—"
             delta = f"{s.delta_bic:.1f}" if np.isfinite(s.delta_bic) else "—"
             gap = f"{best.fit.gap:.3g}" if best else "run failed"
@@ -171,7 +173,7 @@ def _figures(d: Diagnosis, fmt: str) -> list[Path]:
     rank_ax.barh([s.candidate.label for s in ranked][::-1], [s.delta_bic for s in ranked][::-1])
     rank_ax.axvline(-10, color="k", ls=":", lw=0.8)
     rank_ax.set_xlabel("ΔBIC vs the model as given (below −10: significant)")
-    gaps = [d.before.gap] + [s.best.fit.gap for s in d.effects]
+    gaps = [d.before.gap] + [s.estimate.fit.gap for s in d.effects]
     gap_ax.plot(range(len(gaps)), gaps, "o-")
     gap_ax.set_xticks(range(len(gaps)), ["as given"] + [s.candidate.label for s in d.effects], rotation=15)
     gap_ax.set_ylabel("combined gap")

@@ -6,7 +6,9 @@ around its best point, never a gradient method:
 
     screen   two values per candidate (at 30 % and 75 % of its range): is it visible at all, and how good?
     scan     six more values over the range for the most promising candidates
-    zoom     four, then two values between the best point and its neighbours
+    zoom     four, then two values between each of the two lowest local minima and their neighbours
+    vertex   one value at the vertex of a parabola through the profile near its best point (the
+             minimum with the chaotic scatter of single runs smoothed out)
 
 Candidates are ranked by the Bayesian information criterion BIC = χ²_min + k ln n_eff (k = 1 fitted
 parameter; the trigger offset is fitted in every model alike), so a candidate must lower χ² by more
@@ -26,8 +28,10 @@ from clearsim.diagnose.evaluate import Evaluator, Prediction
 SCREEN_POINTS = (0.3, 0.75)  # of the range (in log units for scale parameters)
 SCAN_POINTS = 6
 ZOOM_ROUNDS = (4, 2)
+ZOOM_MINIMA = 2  # zoom around the two lowest local minima of the profile
 SIGNIFICANCE = 10.0  # ΔBIC below −10: "very strong" evidence (Kass & Raftery 1995)
 TIE = 6.0  # BIC within 6 of the best: the data do not tell the two apart
+PROFILE_POINTS = 7  # points of the local parabola through the profile
 VISIBLE = 1.0  # |Δχ²| below 1 at both screening values: the sensors do not see the candidate
 
 
@@ -62,8 +66,11 @@ class Scored:
         return min(finished, key=lambda p: p.chi_square) if finished else None
 
     @property
-    def visible(self) -> bool:
-        return self.best is not None
+    def estimate(self) -> Point | None:
+        """The point reported and added: the lowest χ² of all runs (grid, zooms, the profile's vertex)."""
+        return self.best
+
+    allowance: float = 1.0  # Δχ² of the profile interval, set by `judge`
 
 
 def evaluate_points(evaluator: Evaluator, record: Record, sensors: list[str],
@@ -97,20 +104,50 @@ def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
     evaluate_points(evaluator, record, sensors, [(s, v) for s in chosen for v in s.candidate.grid(SCAN_POINTS)], document)
     for count in ZOOM_ROUNDS:
         evaluate_points(evaluator, record, sensors, [(s, v) for s in chosen for v in _zoom(s, count)], document)
+    evaluate_points(evaluator, record, sensors, [(s, v) for s in chosen if (v := profile_vertex(s)) is not None],
+                    document)
     for s in chosen:
         s.fitted = True
 
 
+def profile_vertex(scored: Scored) -> float | None:
+    """Vertex of a parabola fitted (least squares) to χ² over the points near the best one, in the
+    candidate's unit range: the minimum of the profile with the chaotic scatter of single runs
+    smoothed out. None when the local profile is not convex or the vertex leaves the points' span."""
+    points = [p for p in scored.points if p.fit is not None]
+    if len(points) < 4:
+        return None
+    units = scored.candidate.to_unit([p.value for p in points])
+    chi = np.array([p.chi_square for p in points])
+    centre = float(scored.candidate.to_unit(scored.best.value))
+    near = np.argsort(np.abs(units - centre))[:PROFILE_POINTS]
+    if np.ptp(units[near]) <= 0.0:
+        return None
+    a, b, _ = np.polyfit(units[near] - centre, chi[near], 2)
+    if a <= 0.0:
+        return None
+    vertex = centre - b / (2.0 * a)
+    if not units[near].min() <= vertex <= units[near].max():
+        return None
+    return float(scored.candidate.from_unit(vertex))
+
+
 def _zoom(scored: Scored, count: int) -> list[float]:
-    """`count` new values between the best point and its neighbours (in the candidate's unit range)."""
-    units = np.sort(np.unique(scored.candidate.to_unit([p.value for p in scored.points])))
-    best = float(scored.candidate.to_unit(scored.best.value)) if scored.best else 0.5
-    k = int(np.argmin(np.abs(units - best)))
-    below = units[k - 1] if k > 0 else 0.0
-    above = units[k + 1] if k + 1 < len(units) else 1.0
-    half = count // 2
-    new = [best - (best - below) * (i + 1) / (half + 1) for i in range(half)]
-    new += [best + (above - best) * (i + 1) / (half + 1) for i in range(count - half)]
+    """`count` new values between each of the ZOOM_MINIMA lowest local minima of the profile and
+    their neighbours (in the candidate's unit range): the cost of a clearance has several."""
+    points = sorted((p for p in scored.points if p.fit is not None), key=lambda p: p.value)
+    if not points:
+        return []
+    units = scored.candidate.to_unit([p.value for p in points])
+    chi = np.array([p.chi_square for p in points])
+    minima = [k for k in range(len(chi)) if (k == 0 or chi[k] <= chi[k - 1]) and (k + 1 == len(chi) or chi[k] <= chi[k + 1])]
+    new = []
+    for k in sorted(minima, key=lambda k: chi[k])[:ZOOM_MINIMA]:
+        below = units[k - 1] if k > 0 else 0.0
+        above = units[k + 1] if k + 1 < len(units) else 1.0
+        half = count // 2
+        new += [units[k] - (units[k] - below) * (i + 1) / (half + 1) for i in range(half)]
+        new += [units[k] + (above - units[k]) * (i + 1) / (count - half + 1) for i in range(count - half)]
     return [float(scored.candidate.from_unit(u)) for u in new if 0.0 <= u <= 1.0]
 
 
@@ -120,7 +157,8 @@ def judge(scored: list[Scored], baseline: Fit, record: Record) -> list[Scored]:
     for s in scored:
         if s.best is None:
             continue
-        s.bic = s.best.chi_square + penalty
+        s.allowance = max(1.0, s.best.chi_square / max(record.effective_samples, 1.0))
+        s.bic = s.estimate.chi_square + penalty
         s.delta_bic = s.bic - baseline.chi_square
         s.interval = interval(s, record)
     ranked = sorted(scored, key=lambda s: (not s.fitted, s.bic))
@@ -134,7 +172,7 @@ def interval(scored: Scored, record: Record) -> tuple[float, float]:
     values = np.array([p.value for p in finished])
     chi = np.array([p.chi_square for p in finished])
     best = float(chi.min())
-    allowance = max(1.0, best / max(record.effective_samples, 1.0))
+    allowance = scored.allowance
     inside = np.nonzero(chi <= best + allowance)[0]
     lo, hi = inside.min(), inside.max()
     units = scored.candidate.to_unit(values)
@@ -151,7 +189,7 @@ def mark_ties(ranked: list[Scored], all_sensors_scale: dict[str, float]) -> None
     ties = [s for s in ranked[1:] if s.fitted and s.best is not None and s.bic - winner.bic <= TIE]
     winner.ambiguous_with = [s.candidate.label for s in ties]
     if ties:
-        winner.telling_sensor = telling_sensor(winner.best.prediction, [s.best.prediction for s in ties],
+        winner.telling_sensor = telling_sensor(winner.estimate.prediction, [s.estimate.prediction for s in ties],
                                                all_sensors_scale)
 
 

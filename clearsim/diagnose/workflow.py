@@ -86,12 +86,12 @@ class Diagnosis:
     @property
     def after(self) -> Fit:
         found = self.effects
-        return found[-1].best.fit if found else self.before
+        return found[-1].estimate.fit if found else self.before
 
     @property
     def after_prediction(self) -> Prediction:
         found = self.effects
-        return found[-1].best.prediction if found else self.iterations[0].baseline_prediction
+        return found[-1].estimate.prediction if found else self.iterations[0].baseline_prediction
 
 
 def chosen_kinds(text: str | None) -> list[str]:
@@ -161,7 +161,7 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
             if iteration.found is None:
                 break
             found_keys.add(iteration.found.candidate.key)
-            document = iteration.found.candidate.applied(document, iteration.found.best.value)
+            document = iteration.found.candidate.applied(document, iteration.found.estimate.value)
     finally:
         executor.close() if hasattr(executor, "close") else None
     return Diagnosis(request, folder, measured, record, sensors, original, document, iterations,
@@ -209,7 +209,7 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
 def effect_line(scored: Scored, baseline: Fit) -> str:
     """'clearance in joint B, clearance = 0.082 mm (0.071–0.094 mm); gap 14.2 → 1.3 (−91%)'."""
     c: Candidate = scored.candidate
-    best = scored.best
+    best = scored.estimate
     low, high = scored.interval
     change = (best.fit.gap - baseline.gap) / baseline.gap if baseline.gap > 0 else 0.0
     tie = f"; fits as well: {', '.join(scored.ambiguous_with)}" if scored.ambiguous_with else ""

@@ -12,6 +12,7 @@ from clearsim.diagnose.align import Record, SMOOTHER_ORDER, smoother_window
 START_FRACTION = 0.05  # a signal has started when it has moved 5 % of its range
 SETTLE_BAND = 0.02  # settled: within ±2 % of the range around the final value
 WINDOW_SECONDS = 1e-3  # moving RMS of the residual over 1 ms
+POSITIONS = ("m", "rad")  # units of displacement and angle sensors
 BAND = 3.0  # a window disagrees where the moving RMS exceeds 3 σ̂
 
 
@@ -55,18 +56,20 @@ def shaking(values: np.ndarray, rate: float) -> float:
 
 
 def features(record: Record, prediction: dict[str, np.ndarray], units: dict[str, str]) -> list[Feature]:
-    """Start, peak, end value, overshoot, settling and shaking of every sensor, measured vs model."""
+    """Start, peak, end value and shaking of every sensor, overshoot and settling of travels; measured vs model."""
     out = []
     for sensor, measured in record.values.items():
         model, unit, t = prediction[sensor], units.get(sensor, ""), record.time
+        tail = max(len(t) // 50, 1)
         pairs = {
             "start time": (start_time(t, measured), start_time(t, model), "s"),
             "peak |value|": (float(np.max(np.abs(measured))), float(np.max(np.abs(model))), unit),
-            "end value": (float(np.mean(measured[-max(len(t) // 50, 1):])), float(np.mean(model[-max(len(t) // 50, 1):])), unit),
-            "overshoot": (overshoot(measured), overshoot(model), "of range"),
-            "settling time": (settling_time(t, measured), settling_time(t, model), "s"),
+            "end value": (float(np.mean(measured[-tail:])), float(np.mean(model[-tail:])), unit),
             "shaking (RMS above trend)": (shaking(measured, record.rate), shaking(model, record.rate), unit),
         }
+        if unit in POSITIONS:  # a travel: it overshoots its end position and settles
+            pairs["overshoot"] = (overshoot(measured), overshoot(model), "of range")
+            pairs["settling time"] = (settling_time(t, measured), settling_time(t, model), "s")
         out += [Feature(sensor, name, m, p, u) for name, (m, p, u) in pairs.items()]
     return out
 

@@ -142,3 +142,57 @@ def test_candidate_documents_are_valid_mechanisms():
         for value in (candidate.low, candidate.high):
             load_mechanism_text(document_text(candidate.applied(document, value)), "candidate", (), CONFIGS)
     assert not any(c.target == "hydraulic_drive" and c.kind == "clearance" for c in candidates)
+
+
+# --- the UHV breaker: bench-like sensors at 15 kHz, noise, the bench's low-pass, a trigger offset -------
+# CI-sized: frictionless clearance joints (the stiction law's stick phases cost ~10 s per run, see
+# docs/performance.md) and rtol 1e-6; the full-resolution study is in docs/diagnose.md.
+
+UHV = str(CONFIGS / "uhv_breaker.yaml")
+UHV_IDEAL = ["--set", "defaults.friction={law: none}", "--set", "joints.A.clearance=0", "--set", "joints.J.clearance=0",
+             "--set", "solver.rtol=1e-6", "--set", "solver.output_rate=30kHz"]
+UHV_BENCH = ["--sensors", "sealing_rod_displacement,turn_arm_angular_velocity", "--rate", "15kHz", "--noise", "0.05%",
+             "--lowpass", "2kHz", "--trigger-offset", "0.7ms"]
+
+
+def uhv_diagnosis(folder: Path, hidden: list[str], *options: str, seed: int = 3) -> dict:
+    record = folder / "bench.csv"
+    sets = [part for s in hidden for part in ("--set", s)]
+    result = invoke("synthesize", UHV, *UHV_IDEAL, *sets, *UHV_BENCH, "--seed", seed, "-o", record)
+    assert result.exit_code == 0, result.output
+    result = invoke("diagnose", UHV, *UHV_IDEAL, "--measured", record, "-o", folder / "report", "--workers", 2,
+                    "--fit-top", 2, *options)
+    assert result.exit_code == 0, result.output
+    return json.loads((folder / "report" / "diagnosis.json").read_text())
+
+
+@pytest.mark.slow
+def test_uhv_hidden_clearance_at_b_is_named_fitted_and_the_gap_shrinks(tmp_path):
+    found = uhv_diagnosis(tmp_path, ["joints.B.clearance=0.08mm"], "--candidates", "clearance,drive")
+    effect = found["effects"][0]
+    assert effect["kind"] == "clearance"
+    assert "B" in {effect["target"], *[label.split("joint ")[-1] for label in effect["ambiguous_with"]]}
+    if effect["target"] == "B":
+        assert effect["parameters"]["clearance"] == pytest.approx(0.08e-3, rel=0.3)
+    assert found["gap_after"] <= 0.3 * found["gap_before"]
+    assert abs(found["trigger_offset_s"]["before"] - 0.7e-3) < 0.1e-3
+
+
+@pytest.mark.slow
+def test_uhv_hidden_drive_lag_is_named_as_drive_not_clearance(tmp_path):
+    found = uhv_diagnosis(tmp_path, ["drivers.hydraulic_drive.lag=2ms"], "--candidates", "clearance,drive", seed=4)
+    effect = found["effects"][0]
+    assert (effect["kind"], effect["target"], list(effect["parameters"])) == ("drive", "hydraulic_drive", ["lag"])
+    assert effect["parameters"]["lag"] == pytest.approx(2e-3, rel=0.2)
+    assert found["gap_after"] <= 0.3 * found["gap_before"]
+
+
+@pytest.mark.slow
+def test_uhv_two_hidden_effects_are_both_found(tmp_path):
+    found = uhv_diagnosis(tmp_path, ["joints.B.clearance=0.08mm", "drivers.hydraulic_drive.lag=2ms"],
+                          "--candidates", "clearance,drive", "--max-effects", "2", seed=5)
+    kinds = {(e["kind"], e["target"]) for e in found["effects"]}
+    assert ("drive", "hydraulic_drive") in kinds
+    clearance = [e for e in found["effects"] if e["kind"] == "clearance"]
+    assert clearance and "B" in {clearance[0]["target"], *[l.split("joint ")[-1] for l in clearance[0]["ambiguous_with"]]}
+    assert found["gap_after"] <= 0.3 * found["gap_before"]

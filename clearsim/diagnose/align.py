@@ -195,6 +195,14 @@ def chi_square(record: Record, residual: dict[str, np.ndarray]) -> float:
     return float(sum(weights[s] * np.sum(r ** 2) for s, r in residual.items()))
 
 
+def chi_square_halves(record: Record, residual: dict[str, np.ndarray]) -> tuple[float, float]:
+    """χ² (D3) of the first and of the second half of the record, for a check on data the other half fitted."""
+    middle = len(record.time) // 2
+    first = {s: r[:middle] for s, r in residual.items()}
+    second = {s: r[middle:] for s, r in residual.items()}
+    return chi_square(record, first), chi_square(record, second)
+
+
 def sensor_gaps(record: Record, residual: dict[str, np.ndarray]) -> dict[str, float]:
     """g_s = RMS(r_s)/σ̂_s (docs/diagnose.md eq. D1)."""
     return {s: float(np.sqrt(np.mean(r ** 2)) / record.noise[s].std) for s, r in residual.items()}

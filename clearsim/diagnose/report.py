@@ -25,7 +25,9 @@ def _effect(scored: Scored) -> dict:
     return {"kind": c.kind, "target": c.target, "parameters": {c.parameter: scored.estimate.value},
             "interval": {c.parameter: [low, high]}, "unit": {c.parameter: c.unit},
             "ambiguous_with": scored.ambiguous_with, "telling_sensor": scored.telling_sensor,
-            "delta_bic": scored.delta_bic, "gap": scored.estimate.fit.gap}
+            "delta_bic": scored.delta_bic, "gap": scored.estimate.fit.gap,
+            "delta_chi_square_halves": list(scored.halves) if scored.halves else None,
+            "confirmed_on_both_halves": bool(scored.halves and max(scored.halves) < 0.0)}
 
 
 def _ranking(scored: list[Scored]) -> list[dict]:

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from clearsim.diagnose.align import Fit, Record, fit_offset
+from clearsim.diagnose.align import Fit, Record, chi_square_halves, fit_offset, predict, residuals
 from clearsim.diagnose.candidates import Candidate
 from clearsim.diagnose.evaluate import Evaluator, Prediction
 
@@ -59,6 +59,7 @@ class Scored:
     interval: tuple[float, float] | None = None
     ambiguous_with: list[str] = field(default_factory=list)
     telling_sensor: str | None = None
+    halves: tuple[float, float] | None = None  # Δχ² on the first and second half of the record
 
     @property
     def best(self) -> Point | None:
@@ -191,6 +192,17 @@ def mark_ties(ranked: list[Scored], all_sensors_scale: dict[str, float]) -> None
     if ties:
         winner.telling_sensor = telling_sensor(winner.estimate.prediction, [s.estimate.prediction for s in ties],
                                                all_sensors_scale)
+
+
+def halves_improved(record: Record, sensors: list[str], baseline: Point, effect: Point) -> tuple[float, float]:
+    """Δχ² of the effect over the model on each half of the record (both negative: the improvement
+    is not carried by one part of the record alone — the split-record check of DESIGN.md §8)."""
+    def halves(point: Point):
+        aligned = predict(record, point.prediction.time, {s: point.prediction.sensors[s] for s in sensors}, point.fit.offset)
+        return chi_square_halves(record, residuals(record, aligned))
+
+    (base_first, base_second), (first, second) = halves(baseline), halves(effect)
+    return first - base_first, second - base_second
 
 
 def telling_sensor(first: Prediction, others: list[Prediction], scale: dict[str, float]) -> str | None:

@@ -22,7 +22,7 @@ from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for
 from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
 from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
-from clearsim.diagnose.search import SIGNIFICANCE, Scored, judge, mark_ties, refine, score_point, screen, seen_by_sensors
+from clearsim.diagnose.search import SIGNIFICANCE, Scored, halves_improved, judge, mark_ties, refine, score_point, screen, seen_by_sensors
 from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.model.loader import load_mechanism, load_mechanism_text
 from clearsim.units import UnitError, to_si
@@ -200,6 +200,7 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
     if winner is not None:
         mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
+        winner.halves = halves_improved(record, sensors, score_point(record, sensors, 0.0, base_prediction), winner.estimate)
         say(f"  found: {effect_line(winner, baseline)}")
     else:
         say("  no candidate beats the model significantly")
@@ -214,5 +215,7 @@ def effect_line(scored: Scored, baseline: Fit) -> str:
     change = (best.fit.gap - baseline.gap) / baseline.gap if baseline.gap > 0 else 0.0
     tie = f"; fits as well: {', '.join(scored.ambiguous_with)}" if scored.ambiguous_with else ""
     tell = f" (tell apart with sensor {scored.telling_sensor})" if scored.telling_sensor else ""
+    if scored.halves is not None and max(scored.halves) >= 0.0:
+        tell += "; not confirmed: it does not improve both halves of the record"
     return (f"{c.label}, {c.parameter} = {c.shown(best.value)} ({c.shown(low)}–{c.shown(high)}); "
             f"gap {baseline.gap:.3g} → {best.fit.gap:.3g} ({change:+.0%}){tie}{tell}")

@@ -175,6 +175,7 @@ def test_uhv_hidden_clearance_at_b_is_named_fitted_and_the_gap_shrinks(tmp_path)
     if effect["target"] == "B":
         assert effect["parameters"]["clearance"] == pytest.approx(0.08e-3, rel=0.3)
     assert found["gap_after"] <= 0.3 * found["gap_before"]
+    assert effect["confirmed_on_both_halves"]
     assert abs(found["trigger_offset_s"]["before"] - 0.7e-3) < 0.1e-3
 
 

@@ -100,6 +100,25 @@ def seen_by_sensors(scored: Scored, baseline: float) -> bool:
     return any(p.fit is not None and abs(p.chi_square - baseline) > VISIBLE for p in scored.points)
 
 
+def to_fit(screened: list[Scored], baseline: Fit, record: Record, count: int) -> list[Scored]:
+    """The candidates to fit: the `count` with the lowest screening χ², and one more chosen by its
+    sensitivity (the largest |Δχ²| of its screening runs): the one whose sensitivity is nearest
+    above what is left to explain (χ² − n_eff), else the most sensitive. Two screening values rarely
+    hit the narrow valley of a clearance; a candidate whose change is of the size of the gap can
+    reach it, while one that barely moves χ² cannot explain the gap, however lucky its screening."""
+    by_screening = sorted(screened, key=lambda s: s.best.chi_square)
+    chosen = by_screening[:count]
+    excess = max(baseline.chi_square - record.effective_samples, 0.0)
+
+    def sensitivity(s: Scored) -> float:
+        return max(abs(p.chi_square - baseline.chi_square) for p in s.points if p.fit is not None)
+
+    rest = [s for s in by_screening[count:] if sensitivity(s) > VISIBLE]
+    reaching = [s for s in rest if sensitivity(s) >= excess]
+    extra = min(reaching, key=sensitivity) if reaching else max(rest, key=sensitivity, default=None)
+    return chosen + ([extra] if extra is not None and excess > 0.0 else [])
+
+
 def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
     """Scan, then zoom twice around each candidate's best point (each round one parallel batch)."""
     evaluate_points(evaluator, record, sensors, [(s, v) for s in chosen for v in s.candidate.grid(SCAN_POINTS)], document)

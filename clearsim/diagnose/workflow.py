@@ -22,7 +22,7 @@ from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for
 from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
 from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
-from clearsim.diagnose.search import SIGNIFICANCE, Scored, halves_improved, judge, mark_ties, refine, score_point, screen, seen_by_sensors
+from clearsim.diagnose.search import SIGNIFICANCE, Scored, halves_improved, judge, to_fit, mark_ties, refine, score_point, screen, seen_by_sensors
 from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.model.loader import load_mechanism, load_mechanism_text
 from clearsim.units import UnitError, to_si
@@ -192,7 +192,7 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds) if c.key not in found_keys]
     scored = screen(evaluator, record, sensors, candidates, document)
     visible = [s for s in scored if seen_by_sensors(s, baseline.chi_square)]
-    chosen = sorted(visible, key=lambda s: s.best.chi_square)[:request.fit_top]
+    chosen = to_fit(visible, baseline, record, request.fit_top)
     say(f"  screened {len(candidates)} candidates ({len(visible)} visible to the sensors); fitting "
         + ", ".join(s.candidate.label for s in chosen))
     refine(evaluator, record, sensors, chosen, document)

@@ -1,13 +1,15 @@
 """Cases 6 and 5c of docs/validation.md: the seed paper's studies (Meng et al. 2015) on the reconstructed UHV
 model, and the UHV tolerance / output-rate study.
 
-    python docs/scripts/paper_studies.py [OUT] [--figures]   (sweep folders under OUT, default /tmp/clearsim-paper)
+    python docs/scripts/paper_studies.py [OUT] [--figures] [--workers N]   (sweep folders under OUT,
+                                                                          default /tmp/clearsim-paper)
 
---figures writes docs/figures/validation-paper-peak.png (peak acceleration vs clearance, paper and clearsim).
-
-Runs five `clearsim sweep`s on configs/uhv_breaker.yaml (each UHV clearance run takes ~5–30 s;
-the whole script ≈ 3.5 min on 2 cores) and prints the "paper vs clearsim" table from their
-summary.csv files. Re-running resumes: finished cases are reused. Only --figures writes in the repo.
+Runs the `clearsim sweep`s of SWEEPS on configs/uhv_breaker.yaml and prints, from their summary.csv and
+result files: the detailed table, the "paper vs clearsim" table, the start delay at several thresholds,
+the friction study (per joint), the whirl of J, and where on the bearings the contact episodes begin.
+Each UHV clearance run takes 10–40 s at rtol 1e-7 and up to a few minutes at rtol 1e-9 or with plain
+Coulomb friction: the whole script takes ≈ 25 min on 2 otherwise idle cores. Re-running resumes
+(finished cases are reused, ≈ 1 min). Only --figures writes in the repo (docs/figures/validation-paper-*.png).
 """
 
 import csv
@@ -15,114 +17,507 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+import yaml
+
+from clearsim.io.hdf5 import read_result
+from clearsim.sweep.figures import start_time
+
 ROOT = Path(__file__).resolve().parents[2]
 CONFIG = ROOT / "configs" / "uhv_breaker.yaml"
+FIGURES = ROOT / "docs" / "figures"
 
 SWEEPS = {
-    # clearance at J only (A made ideal), vs the ideal mechanism. Ends at 84.9 ms: run to 85 ms this case
-    # fails at t = 85 ms (step size below min_step with J in contact when the drive's acceleration jumps
-    # to 0 at the end of the stroke); the drive is at rest there, so the stroke figures are unaffected
-    "j_only": ["--clearance", "0.01", "--joints", "J", "--set", "joints.A.clearance=0", "--set", "solver.t_end=84.9ms"],
+    # clearance at J only (A made ideal), vs the ideal mechanism
+    "j_only": ["--clearance", "0.01", "--joints", "J", "--set", "joints.A.clearance=0"],
     # clearance at A and J
     "a_and_j": ["--clearance", "0.01,0.03,0.05,0.1", "--joints", "A,J"],
     # dynamic friction coefficient at c = 0.1 mm (A and J; defaults.friction applies to both)
     "friction": ["--clearance", "0.1", "--joints", "A,J", "--set", "defaults.friction.mu_d=0.10,0.15,0.16"],
-    # case 5 for the UHV model (the file's A and J at 0.01 mm): tolerance, then output rate. Ends at 84.9 ms for
-    # the same reason as j_only (the ideal case at rtol 1e-9 fails at t = 85 ms too)
-    "uhv_rtol": ["--set", "solver.rtol=1e-6,1e-7,1e-8,1e-9", "--set", "solver.t_end=84.9ms"],
-    "uhv_rate": ["--set", "solver.output_rate=100kHz,1MHz", "--set", "solver.t_end=84.9ms"],
+    # the same at rtol 1e-9: is the friction trend a tolerance artefact?
+    "friction_rtol": ["--clearance", "0.1", "--joints", "A,J", "--set", "defaults.friction.mu_d=0.10,0.15,0.16",
+                      "--set", "solver.rtol=1e-9"],
+    # the whirl of J (A and J at 0.01 mm) under other friction laws: none, no stiction peak (mu_s = mu_d), Coulomb
+    "frictionless": ["--clearance", "0.01", "--joints", "A,J", "--set", "defaults.friction={law: none}"],
+    "no_stiction_peak": ["--clearance", "0.01", "--joints", "A,J", "--set", "defaults.friction.mu_s=0.16"],
+    "coulomb": ["--clearance", "0.01", "--joints", "A,J", "--set", "defaults.friction={law: coulomb, mu_d: 0.16}"],
+    # case 5 for the UHV model (the file's A and J at 0.01 mm): tolerance, then output rate
+    "uhv_rtol": ["--set", "solver.rtol=1e-6,1e-7,1e-8,1e-9"],
+    "uhv_rate": ["--set", "solver.output_rate=100kHz,1MHz"],
 }
+SWEPT = {"friction": "defaults.friction.mu_d", "friction_rtol": "defaults.friction.mu_d",
+         "uhv_rtol": "solver.rtol", "uhv_rate": "solver.output_rate"}
 
-SWEPT = {"uhv_rtol": "solver.rtol", "uhv_rate": "solver.output_rate"}
-
-PAPER = {  # Meng et al. 2015, as quoted in DESIGN.md §5 / issue 7; None: not given in the text
+PAPER = {  # Meng et al. 2015, section 4 (quoted in DESIGN.md §5 / issue 7); missing: not given in the text
     "j_only": {"0.01": {"acceleration_ratio": 3.58}},
     "a_and_j": {"0.01": {"peak_acceleration_m_s2": 2325.6, "start_delay_ms": 1.6},
-                "0.03": {}, "0.05": {},
                 "0.1": {"peak_acceleration_m_s2": 10345.5, "start_delay_ms": 4.2, "end_error_percent": 8.5}},
-    "friction": {"0.10": {"peak_acceleration_m_s2": 2815.4}, "0.15": {}, "0.16": {"peak_acceleration_m_s2": 2326.6}},
-    "uhv_rtol": {}, "uhv_rate": {},
+    "friction": {"0.10": {"peak_acceleration_m_s2": 2815.4}, "0.16": {"peak_acceleration_m_s2": 2326.6}},
 }
 
+PAPER_WINDOW = 0.010  # s: the paper's Figs. 8(c), 9 and 10 show the first 10 ms of the stroke
+DELAY_FRACTIONS = (0.5, 0.1, 0.01)  # of the ideal peak velocity (the sweep's start delay uses 0.5)
+WHIRL_WINDOW = (0.040, 0.080)  # s: from mid-stroke to just before the end, where J whirls
+DENSE_ARC = 90.0  # degrees: width of the arc whose share of contact onsets is reported
+STICK_SPEED = 1e-4  # m/s: v_s of the file's stiction_step law; |v_t| below it counts as sticking
 
-def run_sweep(name, out):
+
+# ---------------------------------------------------------------- running the sweeps and reading their files
+
+def run_sweep(name, out, workers):
     folder = out / name
-    command = ["clearsim", "sweep", str(CONFIG), *SWEEPS[name], "--out", str(folder)]
+    command = ["clearsim", "sweep", str(CONFIG), *SWEEPS[name], "--out", str(folder), "--workers", str(workers)]
     print(f"$ {' '.join(command)}", file=sys.stderr)
     subprocess.run(command, check=False, stdout=subprocess.DEVNULL)  # a failed case shows in its row
     with open(folder / "summary.csv", newline="") as handle:
-        return list(csv.DictReader(handle)), " ".join(["clearsim sweep configs/uhv_breaker.yaml", *SWEEPS[name]])
+        rows = list(csv.DictReader(handle))
+    for row in rows:
+        row["file"] = folder / f"{row['case']}.h5"
+    return rows
 
 
-def number(row, key, fmt):
-    value = row.get(key, "")
-    return format(float(value), fmt) if value not in ("", None) else "—"
+def command_text(name):
+    return " ".join(["clearsim sweep configs/uhv_breaker.yaml", *(f'"{a}"' if " " in a else a for a in SWEEPS[name])])
 
 
-def paper(value, fmt):
-    return "—" if value is None else format(value, fmt)
+def ideal_row(rows):
+    return next(row for row in rows if not row["reference"])
 
 
-def main():
-    arguments = [a for a in sys.argv[1:] if a != "--figures"]
-    out = Path(arguments[0]) if arguments else Path("/tmp/clearsim-paper")
-    studies = {}
-    out.mkdir(parents=True, exist_ok=True)
+def case_rows(rows):
+    return [row for row in rows if row["reference"]]
+
+
+def row_where(rows, column, value):
+    return next(row for row in case_rows(rows) if float(row[column].split()[0]) == float(value))
+
+
+_LOADED = {}
+
+
+def result(row):
+    """The result file of a summary row, read once."""
+    if row["file"] not in _LOADED:
+        _LOADED[row["file"]] = read_result(row["file"])
+    return _LOADED[row["file"]]
+
+
+def clearance_m(row):
+    return float(row["clearance"].split()[0]) * 1e-3 if row.get("clearance") else float("nan")
+
+
+# ---------------------------------------------------------------- figures of merit read from the result files
+
+def acceleration(data):
+    return np.abs(data["sensors/contact_acceleration"])
+
+
+def window_peak(data, t_end=PAPER_WINDOW):
+    """Peak |a| of the moving contact over the first t_end seconds (the paper's figure window)."""
+    return float(np.max(acceleration(data)[data["time"] <= t_end + 1e-12]))
+
+
+def percentile_99(data):
+    return float(np.percentile(acceleration(data), 99.0))
+
+
+def delay_ms(case, ideal, fraction):
+    """Time shift (ms) of the case's output velocity in reaching `fraction` of the ideal peak velocity."""
+    threshold = fraction * float(np.max(ideal["sensors/contact_velocity"]))
+    shift = (start_time(case["time"], case["sensors/contact_velocity"], threshold, 1.0)
+             - start_time(ideal["time"], ideal["sensors/contact_velocity"], threshold, 1.0))
+    return shift * 1e3
+
+
+def lost_motion_bound_ms(ideal, clearance):
+    """Largest start delay lost motion can explain: the time the ideal output needs to travel 2c at J plus
+    2c at A carried to the output by the start-up lever ratio (every slack taken up against the motion)."""
+    drive = np.abs(ideal["bodies/driving_link/q"][:, 0] - ideal["bodies/driving_link/q"][0, 0])
+    output = ideal["sensors/contact_displacement"] - ideal["sensors/contact_displacement"][0]
+    early = np.flatnonzero(drive > 0)[:20]
+    ratio = float(np.median(output[early] / drive[early]))
+    slack = 2 * clearance * (1.0 + ratio)
+    return start_time(ideal["time"], output, slack, 1.0) * 1e3, ratio
+
+
+def velocity_error_percent(case, ideal):
+    """max |v − v_ideal| over the run, in % of the ideal peak velocity."""
+    v_ideal = np.interp(case["time"], ideal["time"], ideal["sensors/contact_velocity"])
+    return float(np.max(np.abs(case["sensors/contact_velocity"] - v_ideal)) / np.max(v_ideal) * 100.0)
+
+
+def joint_bodies(data, joint):
+    """(bearing body, journal body, bearing radius, clearance) of a clearance joint, from the run's YAML."""
+    document = yaml.safe_load(data["attrs"]["config_yaml"])
+    spec = next(j for j in document["joints"] if j["name"] == joint)
+    return spec["bodies"][0], spec["bodies"][1], _metres(spec.get("bearing_radius", "50 mm")), _metres(spec["clearance"])
+
+
+def _metres(text):
+    if isinstance(text, (int, float)):
+        return float(text)
+    value, unit = str(text).split()
+    return float(value) * {"m": 1.0, "mm": 1e-3, "um": 1e-6}[unit]
+
+
+def friction_by_joint(data, joint):
+    """(stick share of the contact samples, friction energy in J, contact share) of one clearance joint."""
+    in_contact = data[f"joints/{joint}/mode"] != 0
+    sliding = data[f"joints/{joint}/sliding_velocity"]
+    power = np.abs(data[f"joints/{joint}/friction_force"] * sliding)
+    energy = float(np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(data["time"])))
+    stick = float(np.mean(np.abs(sliding[in_contact]) < STICK_SPEED)) if in_contact.any() else float("nan")
+    return stick, energy
+
+
+def whirl(data, joint="J", window=WHIRL_WINDOW):
+    """Orbits of the journal centre in `window` against pure rolling: (turns, rolling turns, frequency Hz,
+    mean |e|/c in contact, slip speed as % of the rolling surface speed)."""
+    bearing, journal, radius, clearance = joint_bodies(data, joint)
+    t = data["time"]
+    inside = (t >= window[0]) & (t <= window[1])
+    e = data[f"joints/{joint}/eccentricity"][inside]
+    eccentricity = np.hypot(e[:, 0], e[:, 1])
+    angle = np.unwrap(np.arctan2(e[:, 1], e[:, 0]))
+    contact = data[f"joints/{joint}/mode"][inside] != 0
+    surface_speed = (data[f"bodies/{bearing}/qd"][inside, 2] * radius
+                     - data[f"bodies/{journal}/qd"][inside, 2] * (radius - clearance))  # ω_B R_B − ω_J R_J
+    rolling_rate = np.where(contact, surface_speed / eccentricity, 0.0)  # ė·t = v_surface when v_t = 0
+    turns = (angle[-1] - angle[0]) / (2 * np.pi)
+    rolling_turns = float(np.sum(0.5 * (rolling_rate[1:] + rolling_rate[:-1]) * np.diff(t[inside]))) / (2 * np.pi)
+    slip = np.abs(data[f"joints/{joint}/sliding_velocity"][inside][contact])
+    slip_percent = float(np.mean(slip) / np.mean(np.abs(surface_speed[contact])) * 100.0)
+    mean_e = float(np.mean(eccentricity[contact]) / clearance)
+    return turns, rolling_turns, abs(turns) / (window[1] - window[0]), mean_e, slip_percent
+
+
+def onset_angles(data, joint):
+    """Where on the bearing each contact episode begins: the angle (deg) of the eccentricity at onset in the
+    bearing body's frame (0° = its x axis; for J, the upper linking board's direction I → J, so 180° faces I)."""
+    bearing = joint_bodies(data, joint)[0]
+    e = data[f"joints/{joint}/eccentricity"]
+    angle = np.unwrap(np.arctan2(e[:, 1], e[:, 0])) - data[f"bodies/{bearing}/q"][:, 2]
+    onsets = np.asarray(data[f"joints/{joint}/episodes/onset"])
+    return np.degrees(np.interp(onsets, data["time"], angle)) % 360.0
+
+
+def densest_arc(angles, width=DENSE_ARC):
+    """(centre in deg, share of the angles within ±width/2 of it, share in that arc plus the opposite one)."""
+    if not len(angles):
+        return float("nan"), float("nan"), float("nan")
+    centres = np.arange(360.0)
+    distance = np.abs((angles[None, :] - centres[:, None] + 180.0) % 360.0 - 180.0)
+    shares = np.mean(distance <= width / 2, axis=1)
+    best = int(np.argmax(shares))
+    opposite = (best + 180) % 360
+    return float(centres[best]), float(shares[best]), float(shares[best] + shares[opposite])
+
+
+# ---------------------------------------------------------------- printed tables
+
+def fmt(value, spec):
+    return "—" if value is None or value == "" or (isinstance(value, float) and np.isnan(value)) else format(float(value), spec)
+
+
+def print_detailed_table(studies):
     print("| study | case | peak \\|a\\| paper (m/s²) | peak \\|a\\| clearsim (m/s²) | ratio to ideal paper | ratio clearsim "
           "| start delay paper (ms) | start delay clearsim (ms, f = 0.5) | end error paper (%) | end error clearsim (%) "
           "| J: free / impact / contact (% of samples) | max F_n A / J (kN) | status |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    commands = []
-    for name in SWEEPS:
-        rows, command = run_sweep(name, out)
-        commands.append(command)
-        studies[name] = rows
+    for name, rows in studies.items():
         for row in rows:
-            swept = f" ({SWEPT[name]} = {row[SWEPT[name]]})" if name in SWEPT else ""
-            if not row["reference"]:  # the ideal case
-                print(f"| {name} | ideal{swept} | — | {number(row, 'peak_acceleration_m_s2', '.1f')} | 1 | 1 | 0 | 0 | 0 | 0 "
-                      f"| — | — | {row['status']} |")
+            print(detailed_row(name, row))
+
+
+def detailed_row(name, row):
+    swept = SWEPT.get(name)
+    if not row["reference"]:
+        label = f"ideal ({swept} = {row[swept]})" if swept in row and row[swept] else "ideal"
+        return (f"| {name} | {label} | — | {fmt(row['peak_acceleration_m_s2'], '.1f')} | 1 | 1 | 0 | 0 | 0 | 0 | — | — "
+                f"| {row['status']} |")
+    key = row[swept] if swept and swept.endswith("mu_d") else row.get("clearance", "").split(" ")[0]
+    label = f"{swept} = {row[swept]}, c = {row['clearance']}" if swept else f"c = {row['clearance']}"
+    quoted = next((v for k, v in PAPER.get(name, {}).items() if key and float(k) == float(key)), {})
+    modes = "/".join(fmt(row.get(f"{mode}_percent[J]"), ".0f") for mode in ("free", "impact", "contact"))
+    forces = "/".join(fmt(float(row[f"max_contact_force_N[{j}]"]) / 1e3, ".1f") if row.get(f"max_contact_force_N[{j}]")
+                      else "—" for j in ("A", "J"))
+    return (f"| {name} | {label} | {fmt(quoted.get('peak_acceleration_m_s2'), '.1f')} "
+            f"| {fmt(row['peak_acceleration_m_s2'], '.1f')} | {fmt(quoted.get('acceleration_ratio'), '.2f')} "
+            f"| {fmt(row['acceleration_ratio'], '.2f')} | {fmt(quoted.get('start_delay_ms'), '.1f')} "
+            f"| {fmt(row['start_delay_ms'], '.3f')} | {fmt(quoted.get('end_error_percent'), '.1f')} "
+            f"| {fmt(row['end_error_percent'], '.3f')} | {modes} | {forces} | {row['status']} |")
+
+
+def print_paper_vs_clearsim(studies):
+    """The compact table of issue 7: the paper's numbers beside clearsim's, over the run and over 0–10 ms."""
+    j_only, a_and_j, friction = studies["j_only"], studies["a_and_j"], studies["friction"]
+    ideal = result(ideal_row(a_and_j))
+    print("\n| quantity | case | paper | clearsim, whole stroke | clearsim, first 10 ms |")
+    print("|---|---|---|---|---|")
+    j = row_where(j_only, "clearance", 0.01)
+    print(f"| peak \\|a\\| / ideal | J only, 0.01 mm | 3.58 | {float(j['acceleration_ratio']):.2f} "
+          f"| {window_peak(result(j)) / window_peak(result(ideal_row(j_only))):.2f} |")
+    for row in case_rows(a_and_j):
+        quoted = PAPER["a_and_j"].get(row["clearance"].split()[0], {})
+        print(f"| peak \\|a\\| (m/s²) | A and J, {row['clearance']} | {fmt(quoted.get('peak_acceleration_m_s2'), '.1f')} "
+              f"| {float(row['peak_acceleration_m_s2']):.1f} | {window_peak(result(row)):.1f} |")
+    for row in case_rows(a_and_j):
+        quoted = PAPER["a_and_j"].get(row["clearance"].split()[0], {})
+        print(f"| start delay (ms), f = 0.5 / 0.01 | A and J, {row['clearance']} | {fmt(quoted.get('start_delay_ms'), '.1f')} "
+              f"| {delay_ms(result(row), ideal, 0.5):.3f} / {delay_ms(result(row), ideal, 0.01):.3f} | — |")
+    big = row_where(a_and_j, "clearance", 0.1)
+    print(f"| kinematic error (%): end displacement / max velocity error | A and J, 0.1 mm | ≈ 8.5 "
+          f"| {float(big['end_error_percent']):.3f} / {velocity_error_percent(result(big), ideal):.2f} | — |")
+    for row in case_rows(friction):
+        mu = row["defaults.friction.mu_d"]
+        quoted = PAPER["friction"].get(mu, {})
+        print(f"| peak \\|a\\| (m/s²) | μ_d = {mu}, A and J 0.1 mm | {fmt(quoted.get('peak_acceleration_m_s2'), '.1f')} "
+              f"| {float(row['peak_acceleration_m_s2']):.1f} | {window_peak(result(row)):.1f} |")
+
+
+def print_start_delays(a_and_j):
+    ideal = result(ideal_row(a_and_j))
+    print("\n| c at A and J | " + " | ".join(f"delay f = {f} (ms)" for f in DELAY_FRACTIONS)
+          + " | lost-motion bound (ms) | max velocity error (% of peak) |")
+    print("|---|" + "---|" * (len(DELAY_FRACTIONS) + 2))
+    for row in case_rows(a_and_j):
+        bound, ratio = lost_motion_bound_ms(ideal, clearance_m(row))
+        delays = " | ".join(f"{delay_ms(result(row), ideal, f):.3f}" for f in DELAY_FRACTIONS)
+        print(f"| {row['clearance']} | {delays} | {bound:.2f} | {velocity_error_percent(result(row), ideal):.2f} |")
+    print(f"\n(start-up lever ratio output/drive: {ratio:.3f}; the bound is the time the ideal output needs to travel "
+          f"2c (1 + ratio))")
+
+
+def print_friction(studies):
+    print("\n| rtol | μ_d | peak \\|a\\| (m/s²) | first 10 ms | 99th pct \\|a\\| | stick share A / J (% of contact) "
+          "| friction energy A / J (J) | sum / written total (J) | status |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for name, rtol in (("friction", "1e-7"), ("friction_rtol", "1e-9")):
+        for row in case_rows(studies[name]):
+            if row["status"] != "complete":
+                print(f"| {rtol} | {row['defaults.friction.mu_d']} | — | — | — | — | — | — | {row['status']} |")
                 continue
-            key = row.get("clearance", "") if name != "friction" else row.get("defaults.friction.mu_d", "")
-            label = f"c = {key}" if name != "friction" else f"μ_d = {key}, c = 0.1 mm"
-            if name in SWEPT:
-                label, key = f"{SWEPT[name]} = {row[SWEPT[name]]}, c = 0.01 mm (A, J)", ""
-            quoted = next((v for k, v in PAPER[name].items() if key and float(k) == float(key.split()[0].removesuffix("mm"))), {})
-            modes = "/".join(number(row, f"{mode}_percent[J]", ".0f") for mode in ("free", "impact", "contact"))
-            forces = "/".join(f"{float(row[f'max_contact_force_N[{joint}]']) / 1e3:.1f}"
-                              if row.get(f"max_contact_force_N[{joint}]") else "—" for joint in ("A", "J"))
-            print(f"| {name} | {label} | {paper(quoted.get('peak_acceleration_m_s2'), '.1f')} "
-                  f"| {number(row, 'peak_acceleration_m_s2', '.1f')} | {paper(quoted.get('acceleration_ratio'), '.2f')} "
-                  f"| {number(row, 'acceleration_ratio', '.2f')} | {paper(quoted.get('start_delay_ms'), '.1f')} "
-                  f"| {number(row, 'start_delay_ms', '.3f')} | {paper(quoted.get('end_error_percent'), '.1f')} "
-                  f"| {number(row, 'end_error_percent', '.3f')} | {modes} | {forces} | {row['status']} |")
-    print("\nReproduce: `python docs/scripts/paper_studies.py`, i.e. the sweeps\n")
-    for command in commands:
-        print(f"- `{command}`")
-    if "--figures" in sys.argv:
-        peak_figure(studies["a_and_j"])
+            data = result(row)
+            (stick_a, energy_a), (stick_j, energy_j) = friction_by_joint(data, "A"), friction_by_joint(data, "J")
+            print(f"| {rtol} | {row['defaults.friction.mu_d']} | {float(row['peak_acceleration_m_s2']):.1f} "
+                  f"| {window_peak(data):.1f} | {percentile_99(data):.1f} | {stick_a * 100:.0f} / {stick_j * 100:.0f} "
+                  f"| {energy_a:.2f} / {energy_j:.2f} | {energy_a + energy_j:.2f} / "
+                  f"{float(data['energy/friction_dissipated'][-1]):.2f} | {row['status']} |")
 
 
-def peak_figure(rows):
+def whirl_cases(studies):
+    """(label, row) of every case whose journal-centre orbit at J is compared with rolling."""
+    cases = [("J only, 0.01 mm", row_where(studies["j_only"], "clearance", 0.01))]
+    cases += [(f"A and J, {row['clearance']}", row) for row in case_rows(studies["a_and_j"])]
+    cases += [(f"A and J, 0.01 mm, rtol {row['solver.rtol']}", row) for row in case_rows(studies["uhv_rtol"])
+              if row["solver.rtol"] == "1e-9"]
+    for name, label in (("frictionless", "no friction"), ("no_stiction_peak", "μ_s = μ_d = 0.16"),
+                        ("coulomb", "Coulomb μ = 0.16")):
+        cases += [(f"A and J, 0.01 mm, {label}", row) for row in case_rows(studies.get(name, []))]
+    return cases
+
+
+def print_whirl(studies):
+    print(f"\n| case | orbits of e at J, {WHIRL_WINDOW[0] * 1e3:.0f}–{WHIRL_WINDOW[1] * 1e3:.0f} ms | rolling would give "
+          "| orbit frequency (Hz) | mean \\|e\\|/c in contact | slip (% of surface speed) | J: free / impact / contact (%) "
+          "| peak \\|a\\| (m/s²) | status |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for label, row in whirl_cases(studies):
+        if not row["file"].exists():
+            continue
+        data = result(row)
+        turns, rolling, frequency, mean_e, slip = whirl(data)
+        modes = "/".join(fmt(row.get(f"{m}_percent[J]"), ".0f") for m in ("free", "impact", "contact"))
+        print(f"| {label} | {turns:.1f} | {rolling:.1f} | {frequency:.0f} | {mean_e:.2f} | {slip:.1f} | {modes} "
+              f"| {fmt(row['peak_acceleration_m_s2'], '.1f')} | {row['status']} |")
+
+
+def print_onsets(a_and_j):
+    print(f"\n| c at A and J | joint | contact episodes (impacts) | densest {DENSE_ARC:.0f}° arc: centre (deg) "
+          f"| share of onsets | with the opposite arc |")
+    print("|---|---|---|---|---|---|")
+    for row in case_rows(a_and_j):
+        data = result(row)
+        for joint in ("A", "J"):
+            centre, share, pair = densest_arc(onset_angles(data, joint))
+            impacts = int(np.sum(data[f"joints/{joint}/episodes/kind"] == 1))
+            print(f"| {row['clearance']} | {joint} | {len(data[f'joints/{joint}/episodes/onset'])} ({impacts}) "
+                  f"| {centre:.0f} | {share * 100:.0f} % | {pair * 100:.0f} % |")
+
+
+# ---------------------------------------------------------------- figures (--figures)
+
+def new_figure(rows, columns, size, **options):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from clearsim.plot.style import apply_style
 
-    cases = [row for row in rows if row["reference"] and row["peak_acceleration_m_s2"]]
-    clearance = [float(row["clearance"].split()[0]) for row in cases]
-    fig, ax = plt.subplots(figsize=(5, 3.4), dpi=100)
-    ax.plot(clearance, [float(row["peak_acceleration_m_s2"]) for row in cases], "o-", label="clearsim (reconstructed geometry)")
-    ax.plot([0.01, 0.1], [2325.6, 10345.5], "s--", label="Meng et al. 2015 (end points in the text)")
-    ideal = next(float(row["peak_acceleration_m_s2"]) for row in rows if not row["reference"])
+    apply_style()
+    return plt.subplots(rows, columns, figsize=size, layout="constrained", **options)
+
+
+def save(figure, name):
+    target = FIGURES / f"validation-paper-{name}.png"
+    figure.savefig(target, dpi=100)
+    print(f"(wrote {target.relative_to(ROOT)})")
+
+
+def response_figure(studies):
+    """The paper's Figs. 8–9: output velocity and acceleration, ideal vs clearances, first 10 ms and the stroke."""
+    figure, axes = new_figure(2, 2, (9.0, 6.0))
+    curves = [("ideal", ideal_row(studies["a_and_j"]), {"color": "black", "linestyle": "--", "zorder": 5})]
+    curves += [(f"J only, {row['clearance']}", row, {"color": "tab:gray"}) for row in case_rows(studies["j_only"])]
+    curves += [(f"A and J, {row['clearance']}", row, {}) for row in case_rows(studies["a_and_j"])]
+    for label, row, style in curves:
+        data = result(row)
+        t_ms = data["time"] * 1e3
+        for column, sensor in enumerate(("contact_velocity", "contact_acceleration")):
+            for line, limit in enumerate((PAPER_WINDOW * 1e3, None)):
+                shown = t_ms <= limit if limit else slice(None)
+                axes[line, column].plot(t_ms[shown], data[f"sensors/{sensor}"][shown], lw=0.8, label=label, **style)
+    for line, span in enumerate(("first 10 ms (the paper's Fig. 9 window)", "whole stroke")):
+        axes[line, 0].set_ylabel("velocity (m/s)")
+        axes[line, 1].set_ylabel("acceleration (m/s²)")
+        for ax in axes[line]:
+            ax.set_xlabel("time (ms)")
+            ax.set_title(span)
+    axes[0, 0].legend(fontsize=7)
+    save(figure, "response")
+
+
+def peak_figure(studies):
+    """Peak |a| against clearance at A and J, whole stroke and first 10 ms, with the paper's end points."""
+    rows = case_rows(studies["a_and_j"])
+    clearance = [clearance_m(row) * 1e3 for row in rows]
+    figure, ax = new_figure(1, 1, (5.5, 3.6))
+    ax.plot(clearance, [float(row["peak_acceleration_m_s2"]) for row in rows], "o-", label="clearsim, whole stroke")
+    ax.plot(clearance, [window_peak(result(row)) for row in rows], "^-", label="clearsim, first 10 ms")
+    ax.plot([0.01, 0.1], [2325.6, 10345.5], "s--", label="Meng et al. 2015 (text: end points only)")
+    ideal = float(ideal_row(studies["a_and_j"])["peak_acceleration_m_s2"])
     ax.axhline(ideal, color="0.6", lw=0.8, label=f"ideal, clearsim ({ideal:.0f} m/s²)")
     ax.set_xlabel("radial clearance at A and J (mm)")
     ax.set_ylabel("peak |a|, moving contact (m/s²)")
     ax.set_ylim(0, None)
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    target = ROOT / "docs" / "figures" / "validation-paper-peak.png"
-    fig.savefig(target)
-    print(f"\n(wrote {target.relative_to(ROOT)})")
+    save(figure, "peak")
+
+
+def friction_figure(studies):
+    """The paper's Fig. 10: acceleration over 10 ms for μ_d 0.10/0.15/0.16, and the peak figures against μ_d."""
+    figure, (traces, peaks) = new_figure(1, 2, (9.0, 3.6))
+    for row in case_rows(studies["friction"]):
+        data = result(row)
+        shown = data["time"] <= PAPER_WINDOW
+        traces.plot(data["time"][shown] * 1e3, data["sensors/contact_acceleration"][shown], lw=0.8,
+                    label=f"μ_d = {row['defaults.friction.mu_d']}")
+    traces.set_xlabel("time (ms)")
+    traces.set_ylabel("acceleration (m/s²)")
+    traces.set_title("A and J at 0.1 mm, first 10 ms")
+    traces.legend(fontsize=7)
+    for name, marker, tolerance in (("friction", "o", "rtol 1e-7"), ("friction_rtol", "x", "rtol 1e-9")):
+        rows = [row for row in case_rows(studies[name]) if row["status"] == "complete"]
+        mu = [float(row["defaults.friction.mu_d"]) for row in rows]
+        peaks.plot(mu, [float(row["peak_acceleration_m_s2"]) for row in rows], marker + "-", color="tab:blue",
+                   label=f"clearsim peak, whole stroke, {tolerance}")
+        peaks.plot(mu, [window_peak(result(row)) for row in rows], marker + "-", color="tab:orange",
+                   label=f"clearsim peak, first 10 ms, {tolerance}")
+        peaks.plot(mu, [percentile_99(result(row)) for row in rows], marker + ":", color="tab:green",
+                   label=f"clearsim 99th percentile, {tolerance}")
+    peaks.plot([0.10, 0.16], [2815.4, 2326.6], "s--", color="tab:red", label="Meng et al. 2015 (text)")
+    peaks.set_xlabel("dynamic friction coefficient μ_d at A and J")
+    peaks.set_ylabel("|a| (m/s²)")
+    peaks.set_ylim(0, None)
+    peaks.legend(fontsize=6)
+    save(figure, "friction")
+
+
+def path_figure(studies):
+    """The paper's Fig. 11: J's journal-centre path coloured by contact mode, in the clearance circle."""
+    from clearsim.plot.data import load_run
+    from clearsim.plot.journal import plot_journal_path
+    from clearsim.plot.style import mode_handles
+
+    rows = [("J only, 0.01 mm", row_where(studies["j_only"], "clearance", 0.01)),
+            ("A and J, 0.01 mm", row_where(studies["a_and_j"], "clearance", 0.01)),
+            ("A and J, 0.1 mm", row_where(studies["a_and_j"], "clearance", 0.1))]
+    figure, axes = new_figure(1, 3, (11.0, 4.2))
+    for ax, (label, row) in zip(axes, rows):
+        plot_journal_path(load_run(row["file"]), "J", ax=ax)
+        ax.set_title(f"joint J, {label}")
+    figure.legend(handles=mode_handles(), loc="outside lower center", ncol=3, fontsize=8)
+    save(figure, "path")
+
+
+def onset_figure(studies):
+    """Where on the bearing contact episodes begin: polar histograms of the onset angle, A and J."""
+    rows = [row_where(studies["a_and_j"], "clearance", c) for c in (0.01, 0.1)]
+    figure, axes = new_figure(2, 2, (7.5, 7.5), subplot_kw={"projection": "polar"})
+    bins = np.radians(np.arange(0.0, 361.0, 10.0))
+    for line, joint in enumerate(("A", "J")):
+        for column, row in enumerate(rows):
+            angles = onset_angles(result(row), joint)
+            centre, share, _ = densest_arc(angles)
+            ax = axes[line, column]
+            ax.hist(np.radians(angles), bins=bins, color="tab:red", alpha=0.8)
+            if not np.isnan(centre):
+                ax.axvspan(np.radians(centre - DENSE_ARC / 2), np.radians(centre + DENSE_ARC / 2), color="0.85", zorder=0)
+            ax.set_title(f"{joint}, c = {row['clearance']}: {len(angles)} onsets,\n{share * 100:.0f} % within "
+                         f"{DENSE_ARC:.0f}° of {centre:.0f}°", fontsize=8)
+    figure.suptitle("angle of e = journal − bearing centre at contact onset, in the bearing's frame\n"
+                    "(A: driving link, 0° = +x, 90° = up; J: upper linking board, 0° = direction I → J, 180° faces I)",
+                    fontsize=9)
+    save(figure, "onsets")
+
+
+def whirl_figure(studies):
+    """Orbit rate of e at J against pure rolling, A and J at 0.01 mm, with and without friction."""
+    figure, ax = new_figure(1, 1, (7.0, 3.4))
+    cases = [("stiction_step (file)", row_where(studies["a_and_j"], "clearance", 0.01))]
+    cases += [("no friction", row) for row in case_rows(studies["frictionless"])]
+    for label, row in cases:
+        data = result(row)
+        bearing, journal, radius, clearance = joint_bodies(data, "J")
+        e = data["joints/J/eccentricity"]
+        t = data["time"]
+        rate = np.gradient(np.unwrap(np.arctan2(e[:, 1], e[:, 0])), t) / (2 * np.pi)
+        smooth = np.convolve(rate, np.ones(100) / 100, mode="same")  # 1 ms running mean
+        ax.plot(t * 1e3, smooth, lw=1.0, label=f"orbit rate, {label}")
+    data = result(cases[0][1])
+    bearing, journal, radius, clearance = joint_bodies(data, "J")
+    e = data["joints/J/eccentricity"]
+    surface = data[f"bodies/{bearing}/qd"][:, 2] * radius - data[f"bodies/{journal}/qd"][:, 2] * (radius - clearance)
+    ax.plot(data["time"] * 1e3, surface / np.maximum(np.hypot(e[:, 0], e[:, 1]), clearance) / (2 * np.pi), "k--", lw=0.8,
+            label="rolling without slip: (ω_B R_B − ω_J R_J) / (2π |e|)")
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("orbit rate of e at J (Hz)")
+    ax.legend(fontsize=7)
+    save(figure, "whirl")
+
+
+FIGURE_MAKERS = (response_figure, peak_figure, friction_figure, path_figure, onset_figure, whirl_figure)
+
+
+def main():
+    arguments = sys.argv[1:]
+    workers = int(arguments[arguments.index("--workers") + 1]) if "--workers" in arguments else 2
+    positional = [a for i, a in enumerate(arguments) if not a.startswith("--") and (i == 0 or arguments[i - 1] != "--workers")]
+    out = Path(positional[0]) if positional else Path("/tmp/clearsim-paper")
+    out.mkdir(parents=True, exist_ok=True)
+    studies = {name: run_sweep(name, out, workers) for name in SWEEPS}
+    print_detailed_table(studies)
+    print("\nReproduce: `python docs/scripts/paper_studies.py`, i.e. the sweeps\n")
+    for name in SWEEPS:
+        print(f"- `{command_text(name)}`")
+    print_paper_vs_clearsim(studies)
+    print_start_delays(studies["a_and_j"])
+    print_friction(studies)
+    print_whirl(studies)
+    print_onsets(studies["a_and_j"])
+    if "--figures" in arguments:
+        print()
+        for make in FIGURE_MAKERS:
+            make(studies)
 
 
 if __name__ == "__main__":

@@ -38,8 +38,8 @@ CASES = [
     Case("uhv-ideal", UHV, ("joints.A.clearance=0", "joints.J.clearance=0")),
     Case("uhv-c0.01", UHV, (), ("solver.t_end=10ms",)),
     Case("uhv-c0.1", UHV, ("joints.A.clearance=0.1mm", "joints.J.clearance=0.1mm"), ("solver.t_end=10ms",)),
-    Case("crank-frictionless", CRANK),
-    Case("crank-friction", CRANK_FRICTION),
+    Case("crank-frictionless", CRANK, (), ("solver.t_end=6ms",)),
+    Case("crank-friction", CRANK_FRICTION, (), ("solver.t_end=6ms",)),
 ]
 
 
@@ -63,6 +63,7 @@ class Measurement:
     error_peak_acceleration: float  # relative, vs the 100× tighter run
     error_max_contact_force: float
     repeats: int
+    peak_memory_mb: float  # traced (numpy included) during the untimed warm-up run
     extra: dict = field(default_factory=dict)
 
 
@@ -82,6 +83,71 @@ def _run(config: Path, overrides, folder: Path, name: str):
     return wall, report, summary
 
 
+def _traced_run(config: Path, overrides, folder: Path) -> float:
+    """The warm-up run under tracemalloc: peak traced memory in MB (numpy arrays included)."""
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        _run(config, overrides, folder, "warm-up")
+        return tracemalloc.get_traced_memory()[1] / 2**20
+    finally:
+        tracemalloc.stop()
+
+
+def clearsim_first_impact(config: Path, t_end: float) -> tuple[float, float]:
+    """(onset, peak normal force) of clearsim's first contact episode, the run stopped at t_end."""
+    from clearsim.model.loader import load_mechanism
+    from clearsim.runner import prepare
+    from clearsim.solver.simulate import Run
+
+    run = Run(prepare(load_mechanism(config, [f"solver.t_end={t_end!r}"])))
+    for _chunk in run.chunks():
+        pass
+    return float(run.episode_log().onset[0]), float(run.statistics().peak_normal_force.max())
+
+
+def profile_split(case: Case, quick: bool, folder: Path) -> dict:
+    """Where one run's wall time goes: integration (compiled loop), output sampling (derived outputs of
+    each sample), HDF5 writing, and the rest (load, assemble, episodes): timers wrapped around the
+    functions that do each, for one extra run."""
+    from clearsim import runner
+    from clearsim.io import hdf5
+    from clearsim.solver import simulate
+
+    spent = {"sampling": 0.0, "hdf5": 0.0}
+
+    def timed(owner, name, bucket):
+        original = getattr(owner, name)
+
+        def wrapper(*args, **kwargs):
+            started = time.perf_counter()
+            try:
+                return original(*args, **kwargs)
+            finally:
+                spent[bucket] += time.perf_counter() - started
+        setattr(owner, name, wrapper)
+        return owner, name, original
+
+    patches = [timed(simulate, "evaluate_samples", "sampling"), timed(runner, "chunk_outputs", "sampling"),
+               timed(runner, "sample_modes", "sampling"), timed(runner, "classify_episodes", "sampling"),
+               timed(hdf5.ResultWriter, "__init__", "hdf5"), timed(hdf5.ResultWriter, "__exit__", "hdf5"),
+               timed(hdf5.ResultWriter, "append", "hdf5"),
+               timed(hdf5.ResultWriter, "replace", "hdf5"), timed(hdf5.ResultWriter, "write_table", "hdf5"),
+               timed(hdf5.ResultWriter, "finish", "hdf5")]
+    try:
+        overrides = case.overrides + (case.quick_overrides if quick else ())
+        wall, report, _ = _run(case.config, overrides, folder, f"{case.name}-profile")
+    finally:
+        for owner, name, original in patches:
+            setattr(owner, name, original)
+    integration = report.statistics.wall_time
+    rest = wall - integration - spent["sampling"] - spent["hdf5"]
+    parts = {"integration_s": integration, "sampling_s": spent["sampling"], "hdf5_s": spent["hdf5"], "other_s": rest}
+    return {"case": case.name, "wall_s": wall, **parts,
+            **{key.replace("_s", "_share"): value / wall for key, value in parts.items()}}
+
+
 def _figures(summary) -> tuple[float, float]:
     peak = summary.peak_acceleration[1] if summary.peak_acceleration else float("nan")
     force = max(summary.peak_contact_force.values(), default=0.0)
@@ -97,7 +163,7 @@ def measure(case: Case, repeats: int, quick: bool, folder: Path) -> Measurement:
 
     overrides = case.overrides + (case.quick_overrides if quick else ())
     solver = load_mechanism(case.config, list(overrides)).mechanism.solver
-    _run(case.config, overrides, folder, "warm-up")  # compiled kernels loaded, caches warm
+    memory = _traced_run(case.config, overrides, folder)  # warm-up: compiled kernels loaded, caches warm
     walls, integration, last = [], [], None
     for k in range(repeats):
         wall, report, summary = _run(case.config, overrides, folder, f"{case.name}-{k}")
@@ -114,7 +180,7 @@ def measure(case: Case, repeats: int, quick: bool, folder: Path) -> Measurement:
         case.name, solver.t_end, statistics.median(walls), min(walls), max(walls), statistics.median(integration),
         stats.steps, stats.rejected_steps, stats.rhs_evaluations, stats.contact_events,
         1e6 * statistics.median(integration) / max(stats.steps, 1), peak, force, ref_peak, ref_force,
-        _relative(peak, ref_peak), _relative(force, ref_force), repeats)
+        _relative(peak, ref_peak), _relative(force, ref_force), repeats, memory)
 
 
 def sweep_throughput(workers: int, quick: bool, folder: Path) -> dict:
@@ -132,65 +198,120 @@ def sweep_throughput(workers: int, quick: bool, folder: Path) -> dict:
             "cases_per_minute": 60.0 * len(plan.cases) / wall, "failed": len(result.failed)}
 
 
+def _wall(m: dict) -> str:
+    return f"{m['wall_median_s']:.3f} s [{m['wall_min_s']:.3f}, {m['wall_max_s']:.3f}]"
+
+
 def table(measurements: list[Measurement], sweep: dict | None, previous: dict | None):
     from rich.table import Table
 
     old = {m["case"]: m for m in (previous or {}).get("cases", [])}
     out = Table(title="clearsim benchmarks (wall: load + assemble + integrate + write HDF5)")
     for column in ("case", "sim. time", "wall median [min, max]", "integration", "steps (rej.)", "RHS", "events",
-                   "µs/step", "err peak acc.", "err max F_n") + (("vs previous",) if previous else ()):
+                   "µs/step", "peak mem.", "err peak acc.", "err max F_n") + (("vs previous",) if previous else ()):
         out.add_column(column, justify="right" if column != "case" else "left")
     for m in measurements:
-        row = [m.case, f"{m.simulated_time_s * 1e3:g} ms", f"{m.wall_median_s:.3f} s [{m.wall_min_s:.3f}, {m.wall_max_s:.3f}]",
-               f"{m.integration_median_s:.3f} s", f"{m.steps} ({m.rejected_steps})", f"{m.rhs_evaluations}",
-               f"{m.contact_events}", f"{m.us_per_step:.1f}", f"{m.error_peak_acceleration:.1e}", f"{m.error_max_contact_force:.1e}"]
+        row = [m.case, f"{m.simulated_time_s * 1e3:g} ms", _wall(asdict(m)), f"{m.integration_median_s:.3f} s",
+               f"{m.steps} ({m.rejected_steps})", f"{m.rhs_evaluations}", f"{m.contact_events}", f"{m.us_per_step:.1f}",
+               f"{m.peak_memory_mb:.0f} MB", f"{m.error_peak_acceleration:.1e}", f"{m.error_max_contact_force:.1e}"]
         if previous:
             before = old.get(m.case)
             row.append(f"{before['wall_median_s'] / m.wall_median_s:.2f}× faster" if before else "—")
         out.add_row(*row)
     if sweep:
-        out.add_row("sweep-8", "", f"{sweep['wall_s']:.1f} s", "", "", "", "", "",
-                    f"{sweep['cases_per_minute']:.0f} cases/min", f"{sweep['workers']} workers",
-                    *([""] if previous else []))
+        out.add_row("sweep-8", "", f"{sweep['wall_s']:.1f} s", "", "", "", "", "", "",
+                    f"{sweep['cases_per_minute']:.1f} cases/min", f"{sweep['workers']} workers", *([""] if previous else []))
     return out
+
+
+def side_by_side(document: dict):
+    """Peer and baseline rows at matched accuracy, with clearsim's in the same run."""
+    from rich.table import Table
+
+    out = Table(title="slider-crank side by side at matched max-contact-force accuracy (each vs its own 100× tighter run)")
+    for column in ("case", "tool", "setting", "wall median [min, max]", "err peak acc.", "err max F_n", "clearsim faster by"):
+        out.add_column(column, justify="left" if column in ("case", "tool") else "right")
+    for key, tool, setting in (("peer", "Exudyn (RK44, fixed step)", lambda r: f"h = {r['step_s']:g} s"),
+                               ("baseline", "solve_ivp (DOP853, events)", lambda r: f"rtol = {r['rtol']:g}")):
+        study = document.get(key)
+        if study is None:
+            continue
+        if "skipped" in study:
+            out.add_row("—", tool, study["skipped"], "", "", "", "")
+            continue
+        for case in study["cases"]:
+            matched = case["matched"]
+            if matched is None:
+                out.add_row(case["case"], tool, "no setting tried reached clearsim's accuracy", "", "", "", "")
+                continue
+            out.add_row(case["case"], tool, setting(matched), _wall(case), f"{matched['error_peak_acceleration']:.1e}",
+                        f"{matched['error_max_contact_force']:.1e}", f"{case['ratio']:.1f}×")
+            out.add_row("", "clearsim (this run)", "rtol = 1e-7", f"{case['clearsim_wall_median_s']:.3f} s",
+                        f"{case['clearsim_error_peak_acceleration']:.1e}", f"{case['clearsim_error_max_contact_force']:.1e}", "")
+    return out
+
+
+def _studies() -> dict:
+    from benchmarks import exudyn_slider_crank, extras, scaling, solve_ivp_slider_crank
+
+    return {"peer": exudyn_slider_crank.peer, "baseline": solve_ivp_slider_crank.baseline,
+            "compile": extras.compile_time, "memory": extras.memory, "scaling": scaling.scaling}
+
+
+PROFILED = ("uhv-ideal", "uhv-c0.01", "uhv-c0.1")
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks", description="clearsim benchmarks (issue #6)")
-    parser.add_argument("--quick", action="store_true", help="1 repeat, shortened UHV cases, short sweep")
+    parser.add_argument("--quick", action="store_true", help="1 repeat, shortened cases, short sweep and studies")
     parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--cases", help="comma-separated case names (default: all); also sweep-8, baseline, compile, memory, scaling")
+    parser.add_argument("--cases", help="comma-separated names (default: all): " + ", ".join(c.name for c in CASES)
+                        + ", sweep-8, profile, peer, baseline, compile, memory, scaling")
     parser.add_argument("--json", type=Path, default=RESULTS / "latest.json")
     parser.add_argument("--compare", type=Path, help="an earlier JSON: wall-time ratios per case")
     args = parser.parse_args(argv)
     from rich.console import Console
 
     from benchmarks import extras
+    from benchmarks.scaling import figure
 
-    console = Console()
+    console = Console(width=220)
+    if args.compare and not args.compare.is_file():
+        parser.error(f"--compare: no such file: {args.compare}")
     chosen = set(args.cases.split(",")) if args.cases else None
+    known = {c.name for c in CASES} | {"sweep-8", "profile", *_studies()}
+    if chosen and chosen - known:
+        parser.error(f"unknown case(s): {', '.join(sorted(chosen - known))}; known: {', '.join(sorted(known))}")
     repeats = 1 if args.quick else args.repeats
     previous = json.loads(args.compare.read_text()) if args.compare else None
     document = {"machine": {"python": platform.python_version(), "processor": platform.processor(),
                             "cores": extras.cores()}, "quick": args.quick, "repeats": repeats, "cases": []}
+    wanted = lambda name: chosen is None or name in chosen  # noqa: E731
     with tempfile.TemporaryDirectory(prefix="clearsim-bench-") as tmp:
         folder = Path(tmp)
         measurements = []
         for case in CASES:
-            if chosen is None or case.name in chosen:
+            if wanted(case.name):
                 console.print(f"[dim]{case.name} …[/]")
                 measurements.append(measure(case, repeats, args.quick, folder))
         document["cases"] = [asdict(m) for m in measurements]
         sweep = None
-        if chosen is None or "sweep-8" in chosen:
+        if wanted("sweep-8"):
             console.print("[dim]sweep-8 …[/]")
             sweep = document["sweep"] = sweep_throughput(2, args.quick, folder)
-        for name, function in extras.STUDIES.items():
-            if chosen is None or name in chosen:
+        if wanted("profile"):
+            console.print("[dim]profile …[/]")
+            document["profile"] = [profile_split(c, args.quick, folder) for c in CASES if c.name in PROFILED]
+        for name, function in _studies().items():
+            if wanted(name):
                 console.print(f"[dim]{name} …[/]")
-                document[name] = function(quick=args.quick, folder=folder, measurements=measurements)
+                document[name] = function(quick=args.quick, folder=folder, measurements=measurements, repeats=repeats)
+    if "scaling" in document and not args.quick:
+        figure(document["scaling"])
     console.print(table(measurements, sweep, previous))
-    for name in extras.STUDIES:
+    if "peer" in document or "baseline" in document:
+        console.print(side_by_side(document))
+    for name in ("profile", "compile", "memory", "scaling"):
         if name in document:
             console.print(extras.describe(name, document[name]))
     args.json.parent.mkdir(parents=True, exist_ok=True)

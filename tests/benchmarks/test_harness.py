@@ -1,24 +1,54 @@
 """The benchmark harness runs and writes every field (no timing is asserted: timings live in benchmarks/)."""
 
 import json
+from dataclasses import fields
 
+import pytest
 import yaml
 
-from benchmarks.extras import four_bar_chain
-from benchmarks.suite import main
+from benchmarks import exudyn_slider_crank
+from benchmarks.scaling import four_bar_chain
+from benchmarks.suite import Measurement, main
 
 
-def test_the_quick_harness_writes_a_complete_json(tmp_path):
-    out = tmp_path / "bench.json"
-    assert main(["--quick", "--cases", "crank-frictionless,scaling", "--json", str(out)]) == 0
-    document = json.loads(out.read_text())
+@pytest.fixture(scope="module")
+def document(tmp_path_factory):
+    out = tmp_path_factory.mktemp("bench") / "bench.json"
+    assert main(["--quick", "--cases", "crank-frictionless,baseline,peer", "--json", str(out)]) == 0
+    return json.loads(out.read_text())
+
+
+def test_the_quick_harness_writes_every_field_of_a_case(document):
     (case,) = document["cases"]
-    assert case["case"] == "crank-frictionless" and case["repeats"] == 1
+    assert set(case) == {f.name for f in fields(Measurement)}
+    assert case["case"] == "crank-frictionless" and case["repeats"] == 1 and document["quick"] is True
     assert case["steps"] > 0 and case["rhs_evaluations"] >= 6 * case["steps"]
     assert 0.0 < case["wall_min_s"] <= case["wall_median_s"] <= case["wall_max_s"]
+    assert case["peak_memory_mb"] > 0.0 and case["us_per_step"] > 0.0
     assert 0.0 <= case["error_peak_acceleration"] < 0.05 and 0.0 <= case["error_max_contact_force"] < 0.05
-    rows = document["scaling"]["rows"]
-    assert all(row["complete"] for row in rows) and {row["clearance_joints"] for row in rows} == {0, 1}
+
+
+def test_the_baseline_states_its_accuracy_and_its_ratio(document):
+    (case,) = document["baseline"]["cases"]
+    assert case["case"] == "crank-frictionless" and case["rows"]
+    complete = {"rtol", "wall_s", "steps", "max_contact_force", "error_max_contact_force", "error_peak_acceleration"}
+    for row in case["rows"]:  # a hand-written run that steps through the wall is a row that says so
+        assert complete <= set(row) or set(row) == {"rtol", "failed"}
+    if case["matched"] is not None:
+        assert case["ratio"] > 0.0 and case["wall_median_s"] > 0.0
+
+
+def test_the_peer_runs_or_says_how_to_install_it(document):
+    peer = document["peer"]
+    if not exudyn_slider_crank.available():
+        assert peer == {"skipped": exudyn_slider_crank.MISSING}
+        pytest.skip(exudyn_slider_crank.MISSING)
+    first = peer["first_impact"]
+    # the peer's model is the same mechanism: the first impact lands within one step of clearsim's
+    assert abs(first["exudyn"]["onset_s"] - first["clearsim"]["onset_s"]) <= 2 * first["exudyn"]["step_s"]
+    assert first["exudyn"]["peak_normal_force"] == pytest.approx(first["minimal_model"]["peak_normal_force"], rel=1e-3)
+    (case,) = peer["cases"]
+    assert {"step_s", "error_max_contact_force", "error_peak_acceleration", "crank_speed_drift"} <= set(case["rows"][0])
 
 
 def test_the_four_bar_chain_is_a_one_degree_of_freedom_mechanism_plus_its_clearance_joints():

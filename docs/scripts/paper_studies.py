@@ -7,9 +7,8 @@ model, and the UHV tolerance / output-rate study.
 Runs the `clearsim sweep`s of SWEEPS on configs/uhv_breaker.yaml and prints, from their summary.csv and
 result files: the detailed table, the "paper vs clearsim" table, the start delay at several thresholds,
 the friction study (per joint), the whirl of J, and where on the bearings the contact episodes begin.
-Each UHV clearance run takes 10–40 s at rtol 1e-7 and up to a few minutes at rtol 1e-9 or with plain
-Coulomb friction: the whole script takes ≈ 25 min on 2 otherwise idle cores. Re-running resumes
-(finished cases are reused, ≈ 1 min). Only --figures writes in the repo (docs/figures/validation-paper-*.png).
+The runs take 7.5 min of integration in all (the slowest, 20–70 s each, are the whirling and 0.1 mm cases
+and the Coulomb run), ≈ 5 min on 2 cores. Re-running resumes (finished cases are reused, ≈ 1 min). Only --figures writes in the repo (docs/figures/validation-paper-*.png).
 """
 
 import csv

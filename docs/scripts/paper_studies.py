@@ -238,7 +238,7 @@ def print_detailed_table(studies):
 def detailed_row(name, row):
     swept = SWEPT.get(name)
     if not row["reference"]:
-        label = f"ideal ({swept} = {row[swept]})" if swept in row and row[swept] else "ideal"
+        label = f"ideal ({swept} = {row[swept]})" if row.get(swept) else "ideal"
         return (f"| {name} | {label} | — | {fmt(row['peak_acceleration_m_s2'], '.1f')} | 1 | 1 | 0 | 0 | 0 | 0 | — | — "
                 f"| {row['status']} |")
     clearance = row.get("clearance") or "0.01 mm (A, J: the file's)"
@@ -365,6 +365,7 @@ def new_figure(rows, columns, size, **options):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     from clearsim.plot.style import apply_style
 
     apply_style()

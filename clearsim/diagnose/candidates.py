@@ -141,30 +141,27 @@ def friction(mechanism, document) -> list[Candidate]:
     return out
 
 
-def stiffness(mechanism, document) -> list[Candidate]:
-    """Contact stiffness K of each clearance joint, from 1/10 to 10 times its present value."""
+def _contact_candidates(mechanism, kind: str, key: str, unit: str, bounds, logarithmic: bool) -> list[Candidate]:
+    """One candidate per clearance joint for a key of its `contact:` block; bounds(present) → (low, high)."""
     out = []
     for joint in _clearance_joints(mechanism):
-        k0 = resolve_clearance(joint, mechanism.defaults).stiffness
+        present = getattr(resolve_clearance(joint, mechanism.defaults), key)
 
         def write(doc, value, name=joint.name):
-            _set(doc, f"joints.{name}.contact.stiffness", value)
+            _set(doc, f"joints.{name}.contact.{key}", value)
 
-        out.append(Candidate("stiffness", joint.name, "stiffness", "N/m^n", 0.1 * k0, 10.0 * k0, True, k0, write))
+        out.append(Candidate(kind, joint.name, key, unit, *bounds(present), logarithmic, present, write))
     return out
+
+
+def stiffness(mechanism, document) -> list[Candidate]:
+    """Contact stiffness K of each clearance joint, from 1/10 to 10 times its present value."""
+    return _contact_candidates(mechanism, "stiffness", "stiffness", "N/m^n", lambda k0: (0.1 * k0, 10.0 * k0), True)
 
 
 def restitution(mechanism, document) -> list[Candidate]:
     """Coefficient of restitution c_e of each clearance joint, 0.3 … 1."""
-    out = []
-    for joint in _clearance_joints(mechanism):
-        c0 = resolve_clearance(joint, mechanism.defaults).restitution
-
-        def write(doc, value, name=joint.name):
-            _set(doc, f"joints.{name}.contact.restitution", value)
-
-        out.append(Candidate("restitution", joint.name, "restitution", "", 0.3, 1.0, False, c0, write))
-    return out
+    return _contact_candidates(mechanism, "restitution", "restitution", "", lambda c0: (0.3, 1.0), False)
 
 
 LAG_BOUNDS = (5e-5, 10e-3)  # s

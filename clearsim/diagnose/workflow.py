@@ -163,7 +163,7 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
             found_keys.add(iteration.found.candidate.key)
             document = iteration.found.candidate.applied(document, iteration.found.estimate.value)
     finally:
-        executor.close() if hasattr(executor, "close") else None
+        executor.close()
     return Diagnosis(request, folder, measured, record, sensors, original, document, iterations,
                      evaluator.simulations, clock.perf_counter() - started, units)
 

@@ -137,6 +137,12 @@ class DaskCluster:
     def describe(self) -> str:
         return f"the Dask cluster at {self.address}"
 
+    def close(self) -> None:
+        """Each `run` closes its own client; a client connected but not used is closed here."""
+        if self.client is not None:
+            self.client.close()
+            self.client = None
+
     def connect(self) -> None:
         """Reach the scheduler before anything is written (an unreachable one is an input error)."""
         if self.client is None:

@@ -237,8 +237,8 @@ def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: l
         angle_law=_int_array([a[3] for a in rows.angles]),
         law_breaks=breaks, law_coefficients=coefficients, law_first=first, law_count=count,
         clearance_bodies=_int_array([c[:2] for c in clearances], 2),
-        clearance_laws=_int_array([(contact.CONTACT_LAWS[c[4].law], friction.FRICTION_LAWS[c[4].friction_law])
-                                   for c in clearances], 2),
+        clearance_laws=_int_array([(contact.CONTACT_LAWS[c[4].law], friction.FRICTION_LAWS[c[4].friction_law],
+                                    friction.STICK_TREATMENTS[c[4].stick]) for c in clearances], 3),
         clearance_params=_float_array([clearance_row(c[2], c[3], c[4]) for c in clearances], CLEARANCE_COLUMNS),
         load_bodies=_int_array([ld[0] for ld in loads]),
         load_params=_float_array([ld[1] for ld in loads], LOAD_COLUMNS),

@@ -16,11 +16,11 @@ import numpy as np
 from numba import njit
 
 from clearsim.assembly.constraints import (
-    constraint_count, evaluate_acceleration_rhs, evaluate_constraints, evaluate_velocity_rhs, jacobian_blocks,
-    jacobian_times, jacobian_transpose_times, prescribed, schur_complement,
+    constraint_count, evaluate_acceleration_rhs, evaluate_constraints, evaluate_jacobian_blocks, evaluate_velocity_rhs,
+    jacobian_blocks, jacobian_times, jacobian_transpose_times, prescribed, schur_complement,
 )
 from clearsim.assembly.forces import (
-    add_applied_forces, add_clearance_forces, add_global_force, clearance_kinematics,
+    STICK, add_applied_forces, add_clearance_forces, add_global_force, clearance_kinematics, stick_row,
 )
 from clearsim.assembly.kinematics import point_position
 from clearsim.assembly.arrays import CL_BEARING_POINT
@@ -93,15 +93,59 @@ def minimum_norm_correction(blocks, bodies, minv, residual, n):
 
 
 @njit(cache=True)
-def accelerations(system, t, q, qd, generalized):
-    """(q̈, λ) from M q̈ + Φ_qᵀ λ = Q, Φ_q q̈ = γ."""
+def stick_count(modes):
+    """Number of clearance joints sticking (each adds a row v_t = 0)."""
+    count = 0
+    for k in range(modes.shape[0]):
+        if modes[k] == STICK:
+            count += 1
+    return count
+
+
+@njit(cache=True)
+def stick_row_index(system, modes, k):
+    """Row of sticking joint k in jacobian_with_sticks: after Φ's rows, in joint order."""
+    row = constraint_count(system)
+    for other in range(k):
+        if modes[other] == STICK:
+            row += 1
+    return row
+
+
+@njit(cache=True)
+def jacobian_with_sticks(system, q, qd, modes):
+    """(blocks, bodies, Ġq̇ of the stick rows): Φ_q with one row G per sticking joint appended."""
     m = constraint_count(system)
+    sticking = stick_count(modes)
+    blocks = np.empty((m + sticking, 2, 3))
+    bodies = np.empty((m + sticking, 2), np.int64)
+    evaluate_jacobian_blocks(system, q, blocks, bodies)
+    curvature = np.zeros(sticking)
+    row = m
+    for k in range(modes.shape[0]):
+        if modes[k] == STICK:
+            bearing_block, journal_block, curvature[row - m] = stick_row(system, k, q, qd)
+            bodies[row, 0] = system.clearance_bodies[k, 0]
+            bodies[row, 1] = system.clearance_bodies[k, 1]
+            for c in range(3):
+                blocks[row, 0, c] = bearing_block[c]
+                blocks[row, 1, c] = journal_block[c]
+            row += 1
+    return blocks, bodies, curvature
+
+
+@njit(cache=True)
+def accelerations(system, t, q, qd, generalized, modes):
+    """(q̈, λ) from M q̈ + Φ_qᵀ λ = Q, Φ_q q̈ = γ; λ ends with −F_t of each sticking joint."""
+    m = constraint_count(system)
+    sticking = stick_count(modes)
     minv = inverse_mass(system)
-    if m == 0:
+    if m + sticking == 0:
         return minv * generalized, np.zeros(0)
-    blocks, bodies = jacobian_blocks(system, q)
-    gamma = np.empty(m)
+    blocks, bodies, curvature = jacobian_with_sticks(system, q, qd, modes)
+    gamma = np.empty(m + sticking)
     evaluate_acceleration_rhs(system, t, q, qd, gamma)
+    gamma[m:] = -curvature
     return constrained_response(blocks, bodies, minv, generalized, gamma)
 
 
@@ -135,7 +179,7 @@ def rhs(system, t, y, modes, impact_speeds, ydot):
     q = y[:n]
     qd = y[n:2 * n]
     generalized, applied, damping, contact, friction = generalized_forces(system, t, q, qd, modes, impact_speeds)
-    qdd, lam = accelerations(system, t, q, qd, generalized)
+    qdd, lam = accelerations(system, t, q, qd, generalized, modes)
     ydot[:n] = qd
     ydot[n:2 * n] = qdd
     ydot[2 * n + WORK_DRIVER] = driver_power(system, t, lam)
@@ -165,12 +209,12 @@ def project_positions(system, t, q, tolerance, max_iterations):
 
 
 @njit(cache=True)
-def project_velocities(system, t, q, qd):
-    """q̇ ← q̇ − M⁻¹Φ_qᵀ S⁻¹ (Φ_q q̇ − ν): the nearest consistent velocity in the M metric."""
-    m = constraint_count(system)
+def project_velocities(system, t, q, qd, modes):
+    """q̇ ← q̇ − M⁻¹Φ_qᵀ S⁻¹ (Φ_q q̇ − ν): the nearest consistent velocity in the M metric (stick rows: ν = 0)."""
+    m = constraint_count(system) + stick_count(modes)
     if m == 0:
         return
-    blocks, bodies = jacobian_blocks(system, q)
+    blocks, bodies, _ = jacobian_with_sticks(system, q, qd, modes)
     nu = np.empty(m)
     evaluate_velocity_rhs(system, t, nu)
     qd -= minimum_norm_correction(blocks, bodies, inverse_mass(system), jacobian_times(blocks, bodies, qd) - nu, q.shape[0])

@@ -19,14 +19,19 @@ from clearsim.assembly.arrays import (
     CL_V_HIGH, CL_V_LOW,
 )
 from clearsim.assembly.kinematics import (
-    GROUND, add_point_force, body_pose, body_rates, point_position, point_velocity,
+    GROUND, add_point_force, body_pose, body_rates, point_position, point_velocity, rotate,
 )
 from clearsim.assembly.constraints import prescribed
 from clearsim.physics.contact import elastic_energy, elastic_force, normal_force
-from clearsim.physics.friction import friction_coefficient
+from clearsim.physics.friction import STICK_EXACT, friction_coefficient, sliding_coefficient
 
+# modes of a clearance joint, constant within a step. CONTACT is any contact of a smooth friction
+# law, and sliding along +t under an exact-stick law; STICK and SLIDE_BACK (sliding along −t)
+# only occur under an exact-stick law (docs/model.md §4)
 FREE = 0
 CONTACT = 1
+STICK = 2
+SLIDE_BACK = 3
 
 
 @njit(cache=True)
@@ -62,6 +67,30 @@ def clearance_kinematics(system, k, q, qd):
 
 
 @njit(cache=True)
+def stick_row(system, k, q, qd):
+    """Stick constraint v_t = G q̇ = 0 of joint k: (G's bearing block, G's journal block, Ġ q̇).
+
+    G q̇ = t·(ṙ_J − ṙ_B) + (n·a_J + R_J) ω_J − (n·a_B + R_B) ω_B with a = A s the arms of the joint
+    centres, and Ġ q̇ = −φ̇ (n·ė) − ω_J² (t·a_J) + ω_B² (t·a_B), φ̇ = t·ė/|e| (docs/model.md §4).
+    """
+    p = system.clearance_params[k]
+    bearing = system.clearance_bodies[k, 0]
+    journal = system.clearance_bodies[k, 1]
+    ex, ey, dex, dey, _, rate, nx, ny, _ = clearance_kinematics(system, k, q, qd)
+    tx, ty = -ny, nx
+    abx, aby = rotate(body_pose(q, bearing)[2], p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+    ajx, ajy = rotate(body_pose(q, journal)[2], p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
+    wb = body_rates(qd, bearing)[2]
+    wj = body_rates(qd, journal)[2]
+    eccentricity = np.sqrt(ex * ex + ey * ey)
+    orbit_rate = (tx * dex + ty * dey) / eccentricity if eccentricity > 1e-300 else 0.0
+    bearing_block = (-tx, -ty, -(nx * abx + ny * aby) - p[CL_BEARING_RADIUS])
+    journal_block = (tx, ty, nx * ajx + ny * ajy + p[CL_JOURNAL_RADIUS])
+    curvature = -orbit_rate * rate - wj * wj * (tx * ajx + ty * ajy) + wb * wb * (tx * abx + ty * aby)
+    return bearing_block, journal_block, curvature
+
+
+@njit(cache=True)
 def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact_speed):
     """(F_n, F_t, K δⁿ) of clearance joint k; zero in free flight. F_t is the signed force along t."""
     if mode == FREE or penetration <= 0.0:
@@ -70,8 +99,14 @@ def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact
     guarded_speed = max(impact_speed, p[CL_MIN_IMPACT_SPEED])  # grazing guard, docs/model.md
     force = normal_force(system.clearance_laws[k, 0], penetration, rate, guarded_speed,
                          p[CL_STIFFNESS], p[CL_EXPONENT], p[CL_RESTITUTION])
-    mu = friction_coefficient(system.clearance_laws[k, 1], sliding, p[CL_MU_S], p[CL_MU_D],
-                              p[CL_V_LOW], p[CL_V_HIGH])
+    law = system.clearance_laws[k, 1]
+    if system.clearance_laws[k, 2] != STICK_EXACT:
+        mu = friction_coefficient(law, sliding, p[CL_MU_S], p[CL_MU_D], p[CL_V_LOW], p[CL_V_HIGH])
+    elif mode == STICK:
+        mu = 0.0  # the stick constraint's multiplier carries the friction force
+    else:
+        direction = -1.0 if mode == SLIDE_BACK else 1.0
+        mu = direction * sliding_coefficient(law, abs(sliding), p[CL_MU_S], p[CL_MU_D], p[CL_V_LOW], p[CL_V_HIGH])
     return force, -mu * force, elastic_force(penetration, p[CL_STIFFNESS], p[CL_EXPONENT])
 
 
@@ -83,6 +118,7 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized):
     for k in range(system.clearance_bodies.shape[0]):
         ex, ey, dex, dey, penetration, rate, nx, ny, sliding = clearance_kinematics(system, k, q, qd)
         fn, ft, elastic = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], impact_speeds[k])
+        contact_loss += (fn - elastic) * rate  # also while the damping term clips F_n to 0 with δ > 0
         if fn == 0.0:
             continue
         p = system.clearance_params[k]
@@ -95,7 +131,6 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized):
                          by + ey + p[CL_JOURNAL_RADIUS] * ny, fx, fy)
         add_global_force(generalized, q, bearing, bx + p[CL_BEARING_RADIUS] * nx,
                          by + p[CL_BEARING_RADIUS] * ny, -fx, -fy)
-        contact_loss += (fn - elastic) * rate
         friction_loss -= ft * sliding
     return contact_loss, friction_loss
 

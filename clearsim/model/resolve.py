@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from clearsim.model.schema import DEFAULT_CONTACT, FRICTION_PARAMETERS, ContactSpec, Defaults, FrictionSpec
+from clearsim.model.schema import DEFAULT_CONTACT, FRICTION_OPTIONS, FRICTION_PARAMETERS, ContactSpec, Defaults, FrictionSpec
 from clearsim.units import UnitError, contact_stiffness_to_si
 
 BUILTIN_FRICTION = FrictionSpec(law="none")
@@ -48,6 +48,7 @@ class ClearanceParameters:
     mu_d: float
     v_low: float  # m/s: v_s (stiction_step) or v_0 (ambrosio); 0 when unused
     v_high: float  # m/s: v_d (stiction_step) or v_1 (ambrosio); 0 when unused
+    stick: str  # "exact" (a constraint while sticking) or "smooth" (the law as written)
     initial_eccentricity: tuple[float, float] = (0.0, 0.0)  # m, journal centre − bearing centre, t = 0
     initial_velocity: tuple[float, float] = (0.0, 0.0)  # m/s, its rate at t = 0
 
@@ -112,14 +113,18 @@ def _mm(length: float) -> str:
     return f"{length * 1e3:.6g} mm"
 
 
+INITIAL_PRELOAD = 0.1  # a journal may start pressed into the wall (its static load) by up to 10 % of c
+
+
 def _initial_eccentricity(joint, clearance: float) -> tuple[float, float]:
     if joint.initial_eccentricity is None:
         return (0.0, 0.0)
     x, y = joint.initial_eccentricity
-    if math.hypot(x, y) > clearance * (1.0 + 1e-9):
+    if math.hypot(x, y) > clearance * (1.0 + INITIAL_PRELOAD):
         raise ResolveError(("initial_eccentricity",), f"initial eccentricity |e| = {_mm(math.hypot(x, y))} "
                            f"lies outside the clearance circle (c = {_mm(clearance)})",
-                           "the journal centre starts within c of the bearing centre")
+                           f"the journal centre starts within c of the bearing centre (pressed into the wall "
+                           f"by at most {INITIAL_PRELOAD:.0%} of c)")
     return (float(x), float(y))
 
 
@@ -178,8 +183,9 @@ def _check_friction(friction: dict, origin: dict) -> None:
         raise _error_at(origin, "law", f"friction law '{law}' needs {', '.join(missing)}",
                         f"add {example} to the joint's friction or to defaults.friction")
     for name in friction:
-        if name != "law" and name not in needed:
-            users = [other for other, params in FRICTION_PARAMETERS.items() if name in params]
+        if name != "law" and name not in needed and name not in FRICTION_OPTIONS.get(law, {}):
+            users = [other for other in FRICTION_PARAMETERS
+                     if name in FRICTION_PARAMETERS[other] or name in FRICTION_OPTIONS.get(other, {})]
             raise _error_at(origin, name, f"friction law '{law}' does not use {name}",
                             f"remove it, or choose a law that does: {', '.join(users)}")
     _check_friction_order(friction, origin)
@@ -213,7 +219,9 @@ def _friction_numbers(friction: dict) -> dict:
     law = friction["law"]
     speeds = {"stiction_step": ("v_s", "v_d"), "ambrosio": ("v_0", "v_1")}.get(law)
     low, high = (friction[speeds[0]], friction[speeds[1]]) if speeds else (0.0, 0.0)
-    return {"mu_s": friction.get("mu_s", 0.0), "mu_d": friction.get("mu_d", 0.0), "v_low": low, "v_high": high}
+    stick = friction.get("stick", FRICTION_OPTIONS.get(law, {}).get("stick", "smooth"))
+    return {"mu_s": friction.get("mu_s", 0.0), "mu_d": friction.get("mu_d", 0.0), "v_low": low, "v_high": high,
+            "stick": stick}
 
 
 # --- contact stiffness ----------------------------------------------------------------------------

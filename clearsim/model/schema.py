@@ -85,6 +85,9 @@ class FrictionSpec(Strict):
     v_d: Speed | None = Field(None, gt=0.0, description="dynamic transition speed (stiction_step)")
     v_0: Speed | None = Field(None, ge=0.0, description="speed below which friction is zero (ambrosio)")
     v_1: Speed | None = Field(None, gt=0.0, description="speed above which friction is full (ambrosio)")
+    stick: Literal["exact", "smooth"] | None = Field(
+        None, description="sticking (stiction_step, coulomb): `exact` holds v_t = 0 while |F_t| <= mu_s F_n "
+        "(default); `smooth` integrates the law as written (the STEP band through zero, the bare sign function)")
 
 
 FRICTION_PARAMETERS = {
@@ -93,6 +96,7 @@ FRICTION_PARAMETERS = {
     "stiction_step": ("mu_s", "mu_d", "v_s", "v_d"),
     "ambrosio": ("mu_d", "v_0", "v_1"),
 }
+FRICTION_OPTIONS = {"coulomb": {"stick": "exact"}, "stiction_step": {"stick": "exact"}}  # optional keys, defaults
 
 
 class Defaults(Strict):

@@ -21,6 +21,13 @@ FRICTION_LAWS = {
     "ambrosio": AMBROSIO,
 }
 
+# how a law treats sticking (column 2 of clearance_laws): "smooth" integrates the law as written
+# (the STEP band through zero, the bare sign function); "exact" makes a sticking contact a
+# constraint v_t = 0 that holds while |F_t| <= μ_s F_n (stiction_step and coulomb only)
+STICK_SMOOTH = 0
+STICK_EXACT = 1
+STICK_TREATMENTS = {"smooth": STICK_SMOOTH, "exact": STICK_EXACT}
+
 
 @njit(cache=True)
 def _sign(value):
@@ -73,4 +80,28 @@ def friction_coefficient(law, sliding_velocity, mu_s, mu_d, v_low, v_high):
         return _stiction_step(sliding_velocity, mu_s, mu_d, v_low, v_high)
     if law == AMBROSIO:
         return _ambrosio(sliding_velocity, mu_d, v_low, v_high)
+    return 0.0
+
+
+@njit(cache=True)
+def sliding_coefficient(law, speed, mu_s, mu_d, v_low, v_high):
+    """|μ| of a journal sliding at |v_t| = speed > 0 when sticking is a constraint (docs/model-contact.md §2).
+
+    The limit v_s → 0 of the stiction band: μ_s up to v_s, the STEP blend to μ_d at v_d, μ_d beyond
+    (stiction_step); μ_d at any speed (coulomb). Other laws have no sticking phase.
+    """
+    if law == STICTION_STEP:
+        return step_blend(speed, v_low, mu_s, v_high, mu_d)
+    if law == COULOMB:
+        return mu_d
+    return 0.0
+
+
+@njit(cache=True)
+def static_coefficient(law, mu_s, mu_d):
+    """Largest |F_t|/F_n a sticking contact holds: μ_s (stiction_step), μ_d (coulomb), 0 otherwise."""
+    if law == STICTION_STEP:
+        return mu_s
+    if law == COULOMB:
+        return mu_d
     return 0.0

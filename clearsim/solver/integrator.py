@@ -22,17 +22,25 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from clearsim.assembly.arrays import CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_STIFFNESS
-from clearsim.assembly.dynamics import (
-    coordinate_count, effective_mass, project_positions, project_velocities, rhs,
+from clearsim.assembly.arrays import (
+    CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_STIFFNESS,
 )
-from clearsim.assembly.forces import CONTACT, FREE, clearance_kinematics, contact_force_magnitudes
+from clearsim.assembly.dynamics import (
+    accelerations, coordinate_count, effective_mass, generalized_forces, project_positions, project_velocities, rhs,
+    stick_row_index,
+)
+from clearsim.assembly.forces import (
+    CONTACT, FREE, SLIDE_BACK, STICK, clearance_kinematics, contact_force_magnitudes,
+)
+from clearsim.physics.friction import STICK_EXACT, static_coefficient
 from clearsim.solver.dopri import STAGES, error_norm, interpolate, step
 
 # real_state slots
 R_TIME, R_STEP, R_T_END, R_RTOL, R_ATOL, R_MAX_STEP, R_MIN_STEP, R_SAMPLE_DT, R_VIOLATION = range(9)
 # int_state slots
-I_STATUS, I_STEPS, I_REJECTED, I_RHS, I_EVENTS, I_SAMPLES, I_NEXT_SAMPLE, I_FAIL_JOINT, I_LOG, I_TOTAL_SAMPLES = range(10)
+(I_STATUS, I_STEPS, I_REJECTED, I_RHS, I_EVENTS, I_SAMPLES, I_NEXT_SAMPLE, I_FAIL_JOINT, I_LOG, I_TOTAL_SAMPLES,
+ I_FRICTION_EVENTS) = range(11)
+INT_SLOTS = 11
 
 RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END = range(8)
 
@@ -40,6 +48,9 @@ SUBDIVISIONS = 4  # points per step at which the event functions are sampled
 PROJECTION_TOLERANCE = 1e-13  # m (rad): max |Φ| kept after each step
 DRIFT_LIMIT = 1e-8  # m: a projection that cannot get below this has lost the assembly
 SAFETY = 0.9
+NORMAL, TANGENTIAL = 0, 1  # the two event functions of a clearance joint
+SLIDE_HYSTERESIS = 1e-9  # m/s: ε_v of the sliding-stops event, far below any resolved sliding speed
+DECIDE_SPEED = 1e-6  # m/s: below it a contact tests whether it sticks (settle_friction)
 DEEPEST_PENETRATION = 0.05  # of the journal radius: beyond it no contact law means anything
 
 
@@ -50,34 +61,67 @@ def hysteresis(system, k):
 
 
 @njit(cache=True)
-def event_value(system, k, y, mode):
-    """(g, ġ): δ in free flight (onset at g ↑ 0), δ + ε in contact (loss at g ↓ 0)."""
-    n = coordinate_count(system)
-    kin = clearance_kinematics(system, k, y[:n], y[n:2 * n])
-    shift = hysteresis(system, k) if mode == CONTACT else 0.0
-    return kin[4] + shift, kin[5]
+def exact_stick(system, k):
+    """Joint k sticks by a constraint (its friction law has the `exact` stick treatment)."""
+    return system.clearance_laws[k, 2] == STICK_EXACT
 
 
 @njit(cache=True)
-def _crossed(mode, before, after):
-    if mode == FREE:
+def friction_reserve(system, t, y, modes, speeds, k):
+    """(μ_s F_n − |F_t|, F_t) of sticking joint k: the friction force its stick constraint needs, and what is left."""
+    n = coordinate_count(system)
+    q = y[:n]
+    qd = y[n:2 * n]
+    generalized = generalized_forces(system, t, q, qd, modes, speeds)[0]
+    friction = -accelerations(system, t, q, qd, generalized, modes)[1][stick_row_index(system, modes, k)]
+    kin = clearance_kinematics(system, k, q, qd)
+    normal = contact_force_magnitudes(system, k, kin[4], kin[5], kin[8], modes[k], speeds[k])[0]
+    p = system.clearance_params[k]
+    return static_coefficient(system.clearance_laws[k, 1], p[CL_MU_S], p[CL_MU_D]) * normal - abs(friction), friction
+
+
+@njit(cache=True)
+def event_value(system, k, kind, t, y, modes, speeds):
+    """(g, ġ) of joint k's event function; the event is g crossing 0 (ġ = 0: unknown).
+
+    NORMAL: δ in free flight (onset at g ↑ 0), δ + ε in contact (loss at g ↓ 0).
+    TANGENTIAL (exact-stick laws in contact): μ_s F_n − |F_t| while sticking (slip at g ↓ 0),
+    s v_t + ε_v while sliding in direction s (the sliding stops or reverses at g ↓ 0).
+    """
+    n = coordinate_count(system)
+    mode = modes[k]
+    if kind == NORMAL:
+        kin = clearance_kinematics(system, k, y[:n], y[n:2 * n])
+        shift = hysteresis(system, k) if mode != FREE else 0.0
+        return kin[4] + shift, kin[5]
+    if mode == FREE or not exact_stick(system, k):
+        return 1.0, 0.0
+    if mode == STICK:
+        return friction_reserve(system, t, y, modes, speeds, k)[0], 0.0
+    direction = -1.0 if mode == SLIDE_BACK else 1.0
+    return direction * clearance_kinematics(system, k, y[:n], y[n:2 * n])[8] + SLIDE_HYSTERESIS, 0.0
+
+
+@njit(cache=True)
+def _crossed(mode, kind, before, after):
+    if kind == NORMAL and mode == FREE:
         return before < 0.0 and after >= 0.0
     return before >= 0.0 and after < 0.0
 
 
 @njit(cache=True)
-def _value_at(system, k, mode, y, stages, h, theta, scratch):
+def _value_at(system, k, kind, t, y, stages, h, theta, modes, speeds, scratch):
     interpolate(y, stages, h, theta, scratch)
-    return event_value(system, k, scratch, mode)
+    return event_value(system, k, kind, t + theta * h, scratch, modes, speeds)
 
 
 @njit(cache=True)
-def _extremum(system, k, mode, y, stages, h, lo, hi, scratch):
-    """θ where ġ = 0 between lo and hi (ġ changes sign there), by bisection."""
-    rate_lo = _value_at(system, k, mode, y, stages, h, lo, scratch)[1]
+def _extremum(system, k, t, y, stages, h, lo, hi, modes, speeds, scratch):
+    """θ where ġ = 0 between lo and hi (ġ changes sign there), by bisection (NORMAL events)."""
+    rate_lo = _value_at(system, k, NORMAL, t, y, stages, h, lo, modes, speeds, scratch)[1]
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        rate = _value_at(system, k, mode, y, stages, h, mid, scratch)[1]
+        rate = _value_at(system, k, NORMAL, t, y, stages, h, mid, modes, speeds, scratch)[1]
         if (rate > 0.0) == (rate_lo > 0.0):
             lo, rate_lo = mid, rate
         else:
@@ -88,18 +132,19 @@ def _extremum(system, k, mode, y, stages, h, lo, hi, scratch):
 
 
 @njit(cache=True)
-def _root(system, k, mode, y, stages, h, lo, hi, scratch):
+def _root(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
     """θ just past the crossing of g in [lo, hi] (Illinois false position on the dense output)."""
-    g_lo = _value_at(system, k, mode, y, stages, h, lo, scratch)[0]
-    g_hi = _value_at(system, k, mode, y, stages, h, hi, scratch)[0]
+    mode = modes[k]
+    g_lo = _value_at(system, k, kind, t, y, stages, h, lo, modes, speeds, scratch)[0]
+    g_hi = _value_at(system, k, kind, t, y, stages, h, hi, modes, speeds, scratch)[0]
     side = 0
     for _ in range(100):
         if hi - lo <= 1e-13:
             break
         mid = (lo * g_hi - hi * g_lo) / (g_hi - g_lo) if g_hi != g_lo else 0.5 * (lo + hi)
         mid = min(max(mid, lo + 0.01 * (hi - lo)), hi - 0.01 * (hi - lo))
-        g_mid = _value_at(system, k, mode, y, stages, h, mid, scratch)[0]
-        if _crossed(mode, g_lo, g_mid):
+        g_mid = _value_at(system, k, kind, t, y, stages, h, mid, modes, speeds, scratch)[0]
+        if _crossed(mode, kind, g_lo, g_mid):
             hi, g_hi = mid, g_mid
             if side == -1:
                 g_lo *= 0.5
@@ -113,34 +158,37 @@ def _root(system, k, mode, y, stages, h, lo, hi, scratch):
 
 
 @njit(cache=True)
-def first_event(system, k, mode, y, y_new, stages, h, scratch):
-    """θ in (0, 1] of joint k's first event in the step, or 2.0 when there is none."""
-    g_prev, r_prev = event_value(system, k, y, mode)
+def first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch):
+    """θ in (0, 1] of joint k's first event of this kind in the step, or 2.0 when there is none."""
+    mode = modes[k]
+    if kind == TANGENTIAL and (mode == FREE or not exact_stick(system, k)):
+        return 2.0
+    g_prev, r_prev = event_value(system, k, kind, t, y, modes, speeds)
     theta_prev = 0.0
     for i in range(1, SUBDIVISIONS + 1):
         theta = i / SUBDIVISIONS
         if i == SUBDIVISIONS:
-            g, r = event_value(system, k, y_new, mode)
+            g, r = event_value(system, k, kind, t + h, y_new, modes, speeds)
         else:
-            g, r = _value_at(system, k, mode, y, stages, h, theta, scratch)
-        if _crossed(mode, g_prev, g):
-            return _root(system, k, mode, y, stages, h, theta_prev, theta, scratch)
+            g, r = _value_at(system, k, kind, t, y, stages, h, theta, modes, speeds, scratch)
+        if _crossed(mode, kind, g_prev, g):
+            return _root(system, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
         turning = (r_prev > 0.0 and r < 0.0) if mode == FREE else (r_prev < 0.0 and r > 0.0)
-        if turning:  # a graze: δ may cross and return between the two samples
-            peak = _extremum(system, k, mode, y, stages, h, theta_prev, theta, scratch)
-            g_peak = _value_at(system, k, mode, y, stages, h, peak, scratch)[0]
-            if _crossed(mode, g_prev, g_peak):
-                return _root(system, k, mode, y, stages, h, theta_prev, peak, scratch)
+        if kind == NORMAL and turning:  # a graze: δ may cross and return between the two samples
+            peak = _extremum(system, k, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
+            g_peak = _value_at(system, k, kind, t, y, stages, h, peak, modes, speeds, scratch)[0]
+            if _crossed(mode, kind, g_prev, g_peak):
+                return _root(system, k, kind, t, y, stages, h, theta_prev, peak, modes, speeds, scratch)
         g_prev, r_prev, theta_prev = g, r, theta
     return 2.0
 
 
 @njit(cache=True)
-def project_state(system, t, y):
-    """Project q and q̇ of y onto the constraint manifold; returns the remaining max |Φ|."""
+def project_state(system, t, y, modes):
+    """Project q and q̇ of y onto the constraint manifold (and v_t = 0 of sticking joints); returns max |Φ|."""
     n = coordinate_count(system)
     violation = project_positions(system, t, y[:n], PROJECTION_TOLERANCE, 6)
-    project_velocities(system, t, y[:n], y[n:2 * n])
+    project_velocities(system, t, y[:n], y[n:2 * n], modes)
     return violation
 
 
@@ -158,7 +206,7 @@ def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, rea
             interpolate(y, stages, h, (sample_time - t) / h, scratch)
         else:
             scratch[:] = y
-        project_state(system, sample_time, scratch)
+        project_state(system, sample_time, scratch, modes)
         out_t[row] = sample_time
         out_y[row, :] = scratch
         out_modes[row, :] = modes
@@ -183,18 +231,46 @@ def contact_time_step(system, k, q, speed):
 
 
 @njit(cache=True)
-def switch_mode(system, k, t, y, modes, speeds, episode_of, ints, log_joint, log_onset, log_loss,
+def settle_friction(system, k, t, y, modes, speeds):
+    """Choose how joint k's contact carries friction at time t: slide on, or stick if the wall can hold it.
+
+    Sliding faster than DECIDE_SPEED goes on in its direction. Slower (a reversal, or a new contact
+    that barely slides), the joint sticks when the friction force its stick constraint needs is within
+    μ_s F_n, and otherwise slides against that force. Sticking starts with v_t projected to 0.
+    """
+    if not exact_stick(system, k):
+        modes[k] = CONTACT
+        return
+    n = coordinate_count(system)
+    sliding = clearance_kinematics(system, k, y[:n], y[n:2 * n])[8]
+    if abs(sliding) > DECIDE_SPEED:
+        modes[k] = CONTACT if sliding > 0.0 else SLIDE_BACK
+        return
+    modes[k] = STICK
+    reserve, friction = friction_reserve(system, t, y, modes, speeds, k)
+    if reserve < 0.0:
+        modes[k] = SLIDE_BACK if friction > 0.0 else CONTACT
+    else:
+        project_state(system, t, y, modes)
+
+
+@njit(cache=True)
+def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_joint, log_onset, log_loss,
                 log_speed, log_mass):
     """Apply joint k's event at time t; returns the suggested next step."""
     n = coordinate_count(system)
-    if modes[k] == CONTACT:
+    if kind == TANGENTIAL:
+        settle_friction(system, k, t, y, modes, speeds)
+        ints[I_FRICTION_EVENTS] += 1
+        return np.inf
+    if modes[k] != FREE:
         modes[k] = FREE
         log_loss[episode_of[k]] = t
         episode_of[k] = -1
         return np.inf
     speed = max(clearance_kinematics(system, k, y[:n], y[n:2 * n])[5], 0.0)
-    modes[k] = CONTACT
     speeds[k] = speed
+    settle_friction(system, k, t, y, modes, speeds)
     h, mass = contact_time_step(system, k, y[:n], speed)
     row = ints[I_LOG]
     log_joint[row] = k
@@ -211,13 +287,16 @@ def switch_mode(system, k, t, y, modes, speeds, episode_of, ints, log_joint, log
 @njit(cache=True)
 def consistent_modes(system, t, y, modes, speeds, episode_of, ints, log_joint, log_onset, log_loss,
                      log_speed, log_mass):
-    """Switch joints whose mode disagrees with δ at the step start (initial state, restarts)."""
+    """Switch joints whose mode disagrees with the state at the step start (initial state, restarts)."""
     h = np.inf
     for k in range(modes.shape[0]):
-        g = event_value(system, k, y, modes[k])[0]
-        if (modes[k] == FREE and g > 0.0) or (modes[k] == CONTACT and g < 0.0):
-            h = min(h, switch_mode(system, k, t, y, modes, speeds, episode_of, ints, log_joint,
-                                   log_onset, log_loss, log_speed, log_mass))
+        for kind in range(2):
+            if kind == TANGENTIAL and (modes[k] == FREE or not exact_stick(system, k)):
+                continue
+            g = event_value(system, k, kind, t, y, modes, speeds)[0]
+            if g > 0.0 if (kind == NORMAL and modes[k] == FREE) else g < 0.0:
+                h = min(h, switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_joint,
+                                       log_onset, log_loss, log_speed, log_mass))
     return h
 
 
@@ -236,23 +315,64 @@ def free_flight_limit(system, y, modes):
 
 
 @njit(cache=True)
-def update_peaks(system, y, modes, speeds, peak_force):
+def normal_force_at(system, k, y, stages, h, theta, modes, speeds, scratch):
+    """F_n of joint k at t + θh on the step's continuous extension."""
     n = coordinate_count(system)
-    for k in range(modes.shape[0]):
-        kin = clearance_kinematics(system, k, y[:n], y[n:2 * n])
-        force = contact_force_magnitudes(system, k, kin[4], kin[5], kin[8], modes[k], speeds[k])[0]
-        peak_force[k] = max(peak_force[k], force)
+    interpolate(y, stages, h, theta, scratch)
+    kin = clearance_kinematics(system, k, scratch[:n], scratch[n:2 * n])
+    return contact_force_magnitudes(system, k, kin[4], kin[5], kin[8], modes[k], speeds[k])[0]
 
 
 @njit(cache=True)
-def refine_event(system, k, t, y, f, h_event, modes, speeds, stages, y_event, ints):
-    """Integrate from t exactly to joint k's event (Newton on the step length); returns that length."""
+def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
+    """Raise peak_force[k] to the largest F_n of the step: at 4 points, then at an interior maximum.
+
+    A peak between the sampled points is refined by golden-section search on the continuous
+    extension, so the peak contact force does not depend on where the steps happen to end.
+    """
+    golden = 0.5 * (np.sqrt(5.0) - 1.0)
+    for k in range(modes.shape[0]):
+        if modes[k] == FREE:
+            continue
+        best, best_theta = -1.0, 0.0
+        for i in range(SUBDIVISIONS + 1):
+            force = normal_force_at(system, k, y, stages, h, i / SUBDIVISIONS, modes, speeds, scratch)
+            if force > best:
+                best, best_theta = force, i / SUBDIVISIONS
+        lo = max(best_theta - 1.0 / SUBDIVISIONS, 0.0)
+        hi = min(best_theta + 1.0 / SUBDIVISIONS, 1.0)
+        a, b = hi - golden * (hi - lo), lo + golden * (hi - lo)
+        fa = normal_force_at(system, k, y, stages, h, a, modes, speeds, scratch)
+        fb = normal_force_at(system, k, y, stages, h, b, modes, speeds, scratch)
+        for _ in range(40):
+            if hi - lo < 1e-7:
+                break
+            if fa >= fb:
+                hi, b, fb = b, a, fa
+                a = hi - golden * (hi - lo)
+                fa = normal_force_at(system, k, y, stages, h, a, modes, speeds, scratch)
+            else:
+                lo, a, fa = a, b, fb
+                b = lo + golden * (hi - lo)
+                fb = normal_force_at(system, k, y, stages, h, b, modes, speeds, scratch)
+        peak_force[k] = max(peak_force[k], best, fa, fb)
+
+
+@njit(cache=True)
+def refine_event(system, k, kind, t, y, f, h_event, modes, speeds, stages, y_event, ints):
+    """Integrate from t exactly to joint k's event; returns the step length.
+
+    NORMAL events: Newton on the step length until |δ| < 1e-3 ε. TANGENTIAL events: the dense-output
+    root, integrated once (settle_friction decides from the state reached, whichever side it is on).
+    """
     tolerance = 1e-3 * hysteresis(system, k)
     for _ in range(6):
         step(system, t, y, f, h_event, modes, speeds, stages, y_event)
         ints[I_RHS] += 6
-        project_state(system, t + h_event, y_event)
-        g, rate = event_value(system, k, y_event, modes[k])
+        project_state(system, t + h_event, y_event, modes)
+        if kind == TANGENTIAL:
+            break
+        g, rate = event_value(system, k, kind, t + h_event, y_event, modes, speeds)
         if abs(g) <= tolerance or rate == 0.0:
             break
         h_event = min(max(h_event - g / rate, 0.5 * h_event), 2.0 * h_event)
@@ -271,9 +391,6 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
     capacity = out_t.shape[0]
     while True:
         t = real[R_TIME]
-        if ints[I_NEXT_SAMPLE] == 0:
-            emit_samples(system, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints,
-                         out_t, out_y, out_modes, out_speeds, out_episode, scratch)
         if t >= real[R_T_END]:
             ints[I_STATUS] = DONE
             return
@@ -285,10 +402,13 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             return
         switched = consistent_modes(system, t, y, modes, speeds, episode_of, ints, log_joint, log_onset,
                                     log_loss, log_speed, log_mass)
-        if switched < np.inf:
+        if switched < np.inf or ints[I_NEXT_SAMPLE] == 0:
             rhs(system, t, y, modes, speeds, f)
             ints[I_RHS] += 1
             real[R_STEP] = min(real[R_STEP], switched)
+        if ints[I_NEXT_SAMPLE] == 0:  # the first sample, in the modes the initial state has
+            emit_samples(system, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints,
+                         out_t, out_y, out_modes, out_speeds, out_episode, scratch)
         h = min(real[R_STEP], real[R_MAX_STEP], real[R_T_END] - t, free_flight_limit(system, y, modes))
         h = max(h, real[R_MIN_STEP])
         if capacity - ints[I_SAMPLES] < h / real[R_SAMPLE_DT] + 2.0:
@@ -311,20 +431,24 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
         real[R_STEP] = h * min(10.0, max(0.2, SAFETY * norm ** -0.2)) if norm > 0.0 else 10.0 * h
         event_theta = 2.0
         event_joint = -1
+        event_kind = NORMAL
         for k in range(modes.shape[0]):
-            theta = first_event(system, k, modes[k], y, y_new, stages, h, scratch)
-            if theta < event_theta:
-                event_theta, event_joint = theta, k
+            for kind in range(2):
+                theta = first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
+                if theta < event_theta:
+                    event_theta, event_joint, event_kind = theta, k, kind
         if event_joint >= 0:
-            h = refine_event(system, event_joint, t, y, f, event_theta * h, modes, speeds, stages, y_new, ints)
+            h = refine_event(system, event_joint, event_kind, t, y, f, event_theta * h, modes, speeds, stages,
+                             y_new, ints)
         else:
-            violation = project_state(system, t + h, y_new)
+            violation = project_state(system, t + h, y_new, modes)
             real[R_VIOLATION] = max(real[R_VIOLATION], violation)
             if violation > DRIFT_LIMIT:
                 ints[I_STATUS] = DRIFT
                 return
         emit_samples(system, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints,
                      out_t, out_y, out_modes, out_speeds, out_episode, scratch)
+        update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch)
         y[:] = y_new
         real[R_TIME] = t + h if h < real[R_T_END] - t else real[R_T_END]
         ints[I_STEPS] += 1
@@ -332,12 +456,11 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             ints[I_STATUS] = NOT_FINITE
             return
         if event_joint >= 0:
-            suggested = switch_mode(system, event_joint, real[R_TIME], y, modes, speeds, episode_of, ints,
+            suggested = switch_mode(system, event_joint, event_kind, real[R_TIME], y, modes, speeds, episode_of, ints,
                                     log_joint, log_onset, log_loss, log_speed, log_mass)
             real[R_STEP] = min(real[R_STEP], suggested)
-        update_peaks(system, y, modes, speeds, peak_force)
         for k in range(modes.shape[0]):
-            if event_value(system, k, y, FREE)[0] > DEEPEST_PENETRATION * system.clearance_params[k, CL_JOURNAL_RADIUS]:
+            if clearance_kinematics(system, k, y[:n], y[n:2 * n])[4] > DEEPEST_PENETRATION * system.clearance_params[k, CL_JOURNAL_RADIUS]:
                 ints[I_STATUS] = TOO_DEEP
                 ints[I_FAIL_JOINT] = k
                 return

@@ -6,8 +6,10 @@ import numpy as np
 from numba import njit
 
 from clearsim.assembly.constraints import constraint_count
-from clearsim.assembly.dynamics import accelerations, constraint_violation, coordinate_count, generalized_forces
-from clearsim.assembly.forces import clearance_kinematics, contact_force_magnitudes, potential_energy
+from clearsim.assembly.dynamics import (
+    accelerations, constraint_violation, coordinate_count, generalized_forces, stick_row_index,
+)
+from clearsim.assembly.forces import STICK, clearance_kinematics, contact_force_magnitudes, potential_energy
 
 # columns of the per-joint contact output
 C_ECC_X, C_ECC_Y, C_PENETRATION, C_RATE, C_NORMAL, C_FRICTION, C_SLIDING = range(7)
@@ -32,10 +34,13 @@ def evaluate_samples(system, times, states, modes, speeds):
         q = states[s, :n].copy()
         qd = states[s, n:2 * n].copy()
         generalized = generalized_forces(system, t, q, qd, modes[s], speeds[s])[0]
-        qdd[s], lam[s] = accelerations(system, t, q, qd, generalized)
+        qdd[s], multipliers = accelerations(system, t, q, qd, generalized, modes[s])
+        lam[s] = multipliers[:m]
         for k in range(nc):
             ex, ey, _, _, penetration, rate, _, _, sliding = clearance_kinematics(system, k, q, qd)
             fn, ft, _ = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[s, k], speeds[s, k])
+            if modes[s, k] == STICK:
+                ft = -multipliers[stick_row_index(system, modes[s], k)]
             contact[s, k, :] = (ex, ey, penetration, rate, fn, ft, sliding)
         for b in range(system.mass.shape[0]):
             kinetic[s] += 0.5 * (system.mass[b] * (qd[3 * b] ** 2 + qd[3 * b + 1] ** 2)

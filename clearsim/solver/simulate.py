@@ -96,7 +96,7 @@ class Run:
         self.log = [np.zeros(LOG_CAPACITY, np.int64)] + [np.zeros(LOG_CAPACITY) for _ in range(4)]
         self.peak_force = np.zeros(nc)
         self.real = np.zeros(9)
-        self.ints = np.zeros(10, np.int64)
+        self.ints = np.zeros(ig.INT_SLOTS, np.int64)
         dt = 1.0 / settings.output_rate
         self.real[[ig.R_T_END, ig.R_RTOL, ig.R_ATOL, ig.R_MAX_STEP, ig.R_MIN_STEP, ig.R_SAMPLE_DT]] = (
             settings.t_end, settings.rtol, settings.atol, settings.max_step, settings.min_step, dt)

@@ -71,7 +71,10 @@ def test_initial_eccentricity_must_lie_inside_the_clearance_circle():
     inside = resolve_clearance(joint(clearance="0.1 mm", initial_eccentricity=["0.06 mm", "0.08 mm"]),
                                defaults(bearing_radius="10 mm"))
     assert inside.initial_eccentricity == pytest.approx((6e-5, 8e-5))  # |e| = c exactly: touching is allowed
-    error = resolve_error(joint(clearance="0.1 mm", initial_eccentricity=["0.1 mm", "0.01 mm"]))
+    pressed = resolve_clearance(joint(clearance="0.1 mm", initial_eccentricity=["0 mm", "-0.109 mm"]),
+                                defaults(bearing_radius="10 mm"))
+    assert pressed.initial_eccentricity == pytest.approx((0.0, -1.09e-4))  # a static preload up to 10 % of c
+    error = resolve_error(joint(clearance="0.1 mm", initial_eccentricity=["0.11 mm", "0.01 mm"]))
     assert "outside the clearance circle" in error.message and error.path_suffix == ("initial_eccentricity",)
 
 

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from benchmarks.suite import clearsim_ladder
 from tests.support.slider_crank_minimal import FRICTION, FRICTIONLESS, Parameters, ideal_initial_state
 
 FLYWHEEL_INERTIA = 1e4  # kg m², the crank's inertia about its pivot: a prescribed constant speed in effect
@@ -211,7 +212,14 @@ def _matched(rows: list[dict], target: float) -> dict | None:
     return next((row for row in rows if row["error_max_contact_force"] <= target), None)
 
 
-def compare_case(friction: bool, clearsim, repeats: int, quick: bool) -> dict:
+def at_peer_accuracy(row: dict, ladder: list[dict]) -> dict:
+    """An Exudyn row with the loosest clearsim rtol at least as accurate in both errors, and the wall ratio."""
+    keys = ("error_peak_acceleration", "error_max_contact_force")
+    mine = next((r for r in ladder if all(r[k] <= row[k] for k in keys)), None)
+    return {**row, "clearsim": mine, "ratio": row["wall_s"] / mine["wall_s"] if mine else None}
+
+
+def compare_case(friction: bool, clearsim, repeats: int, quick: bool, folder) -> dict:
     """Peer rows for one slider-crank case: the step ladder's errors, the matched step timed `repeats` times."""
     import statistics as stats
 
@@ -225,9 +233,12 @@ def compare_case(friction: bool, clearsim, repeats: int, quick: bool) -> dict:
                      "max_contact_force": result.max_contact_force, "peak_acceleration": result.peak_acceleration,
                      "crank_speed_drift": result.crank_speed_drift, **errors(result, tight)})
     matched = _matched(rows, clearsim.error_max_contact_force)
+    ladder = clearsim_ladder(clearsim.case, repeats, folder)
     out = {"case": clearsim.case, "t_end_s": t_end, "reference_step_s": NOMINAL_STEP / factor, "rows": rows,
            "clearsim_error_max_contact_force": clearsim.error_max_contact_force,
            "clearsim_error_peak_acceleration": clearsim.error_peak_acceleration, "matched": matched}
+    out["clearsim_ladder"] = ladder
+    out["at_peer_accuracy"] = [at_peer_accuracy(row, ladder) for row in rows]
     if matched is None:
         return out
     walls = [simulate(friction, t_end, matched["step_s"]).wall_s for _ in range(repeats)]
@@ -246,5 +257,5 @@ def peer(quick: bool, folder, measurements, repeats: int = 1) -> dict:
         mine = next((m for m in measurements if m.case == name), None)
         if mine is None:
             continue
-        out["cases"].append(compare_case(friction, mine, repeats, quick))
+        out["cases"].append(compare_case(friction, mine, repeats, quick, folder))
     return out

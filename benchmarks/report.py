@@ -41,6 +41,22 @@ def _side_by_side(document: dict) -> list[str]:
     return lines
 
 
+def _at_peer_accuracy(document: dict) -> list[str]:
+    lines = ["| case | Exudyn step | Exudyn wall | its errors (acc. / F_n) | clearsim rtol | clearsim wall | its errors (acc. / F_n) "
+             "| Exudyn / clearsim |", "|" + "---|" * 8]
+    for case in (document.get("peer") or {}).get("cases", []):
+        for r in case.get("at_peer_accuracy", []):
+            mine = r["clearsim"]
+            theirs = f"{r['error_peak_acceleration']:.1e} / {r['error_max_contact_force']:.1e}"
+            if mine is None:
+                lines.append(f"| {case['case']} | {r['step_s']:g} s | {r['wall_s']:.3f} s | {theirs} | none as accurate | | | |")
+                continue
+            lines.append(f"| {case['case']} | {r['step_s']:g} s | {r['wall_s']:.3f} s | {theirs} | {mine['rtol']:g} | "
+                         f"{mine['wall_s']:.3f} s | {mine['error_peak_acceleration']:.1e} / {mine['error_max_contact_force']:.1e} | "
+                         f"**{r['ratio']:.1f}×** |")
+    return lines if len(lines) > 2 else []
+
+
 def _ladders(document: dict) -> list[str]:
     lines = ["| case | tool | setting | wall (one run) | max F_n | error max F_n | error peak acc. |", "|" + "---|" * 7]
     for key, tool, name in (("peer", "Exudyn", "step_s"), ("baseline", "solve_ivp", "rtol")):
@@ -68,7 +84,7 @@ def _scaling(document: dict) -> list[str]:
 
 
 def render(document: dict) -> str:
-    parts = [_cases(document), _side_by_side(document), _ladders(document), _scaling(document)]
+    parts = [_cases(document), _side_by_side(document), _at_peer_accuracy(document), _ladders(document), _scaling(document)]
     return "\n\n".join("\n".join(p) for p in parts if p) + "\n"
 
 

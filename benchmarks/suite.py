@@ -183,6 +183,31 @@ def measure(case: Case, repeats: int, quick: bool, folder: Path) -> Measurement:
         _relative(peak, ref_peak), _relative(force, ref_force), repeats, memory)
 
 
+CLEARSIM_LADDER = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7)  # rtol (atol = rtol/1000), loosest first
+
+
+def clearsim_ladder(case_name: str, repeats: int, folder: Path) -> list[dict]:
+    """The case at each rtol of CLEARSIM_LADDER: wall median and errors against the rtol/100 run of the default.
+
+    Lets a peer that cannot reach clearsim's default accuracy be compared at its own accuracy instead.
+    """
+    case = next(c for c in CASES if c.name == case_name)
+    from clearsim.model.loader import load_mechanism
+
+    solver = load_mechanism(case.config, list(case.overrides)).mechanism.solver
+    tight = case.overrides + (f"solver.rtol={solver.rtol / TIGHTER!r}", f"solver.atol={solver.atol / TIGHTER!r}")
+    ref_peak, ref_force = _figures(_run(case.config, tight, folder, f"{case_name}-ladder-reference")[2])
+    rows = []
+    for rtol in CLEARSIM_LADDER:
+        settings = case.overrides + (f"solver.rtol={rtol!r}", f"solver.atol={rtol / 1000.0!r}")
+        runs = [_run(case.config, settings, folder, f"{case_name}-ladder-{rtol:g}-{k}") for k in range(repeats)]
+        peak, force = _figures(runs[-1][2])
+        rows.append({"rtol": rtol, "wall_s": statistics.median(r[0] for r in runs),
+                     "error_peak_acceleration": _relative(peak, ref_peak),
+                     "error_max_contact_force": _relative(force, ref_force)})
+    return rows
+
+
 def sweep_throughput(workers: int, quick: bool, folder: Path) -> dict:
     """8 slider-crank cases (4 clearances × 2 friction values) on `workers` processes: cases per minute."""
     from clearsim.sweep import LocalPool, SweepRequest, plan_sweep, run_sweep
@@ -252,6 +277,26 @@ def side_by_side(document: dict):
     return out
 
 
+def at_peer_accuracy(document: dict):
+    """Each Exudyn step beside the loosest clearsim rtol that is at least as accurate in both errors."""
+    from rich.table import Table
+
+    study = document.get("peer") or {}
+    out = Table(title="clearsim at the peer's accuracy: each Exudyn step vs the loosest clearsim rtol as accurate in both errors")
+    for column in ("case", "Exudyn step", "Exudyn wall", "err acc. / F_n", "clearsim rtol", "clearsim wall",
+                   "err acc. / F_n", "Exudyn / clearsim"):
+        out.add_column(column, justify="left" if column == "case" else "right")
+    for case in study.get("cases", []):
+        for row in case.get("at_peer_accuracy", []):
+            mine = row["clearsim"]
+            out.add_row(case["case"], f"{row['step_s']:g} s", f"{row['wall_s']:.3f} s",
+                        f"{row['error_peak_acceleration']:.1e} / {row['error_max_contact_force']:.1e}",
+                        f"{mine['rtol']:g}" if mine else "—", f"{mine['wall_s']:.3f} s" if mine else "",
+                        f"{mine['error_peak_acceleration']:.1e} / {mine['error_max_contact_force']:.1e}" if mine else "",
+                        f"{row['ratio']:.1f}×" if mine else "")
+    return out
+
+
 def _studies() -> dict:
     from benchmarks import exudyn_slider_crank, extras, scaling, solve_ivp_slider_crank
 
@@ -312,6 +357,7 @@ def main(argv=None) -> int:
     console.print(table(measurements, sweep, previous))
     if "peer" in document or "baseline" in document:
         console.print(side_by_side(document))
+        console.print(at_peer_accuracy(document))
     for name in ("profile", "compile", "memory", "scaling"):
         if name in document:
             console.print(extras.describe(name, document[name]))

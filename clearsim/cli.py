@@ -94,6 +94,8 @@ def _summary_table(report, summary) -> Table:
         free, impact, contact = summary.contact_time_share[joint]
         table.add_row(f"joint {joint}: max contact force", f"{force:.5g} N")
         table.add_row(f"joint {joint}: free / impact / contact", f"{free:.0%} / {impact:.0%} / {contact:.0%} of the time")
+        if summary.sticking_share.get(joint, 0.0) > 0.0:
+            table.add_row(f"joint {joint}: sticking", f"{summary.sticking_share[joint]:.0%} of the contact time")
     table.add_row("steps (rejected)", f"{stats.steps} ({stats.rejected_steps})")
     table.add_row("contact events", f"{stats.contact_events}")
     table.add_row("wall time", f"{stats.wall_time:.3f} s (integration)")

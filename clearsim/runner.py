@@ -152,6 +152,7 @@ class Summary:
     peak_acceleration: tuple[str, float] | None
     peak_contact_force: dict[str, float]
     contact_time_share: dict[str, tuple[float, float, float]]
+    sticking_share: dict[str, float]  # of the time in contact, per joint (files without /stick: absent)
 
 
 def summarize(path: Path) -> Summary:
@@ -169,7 +170,9 @@ def summarize(path: Path) -> Summary:
     for j in joints:
         mode = data[f"joints/{j}/mode"]
         shares[j] = tuple(float(np.mean(mode == m)) if len(mode) else 0.0 for m in (0, 1, 2))
-    return Summary(peak["velocity"], peak["acceleration"], forces, shares)
+    sticking = {j: float(np.mean(data[f"joints/{j}/stick"][data[f"joints/{j}/mode"] > 0]))
+                for j in joints if f"joints/{j}/stick" in data and np.any(data[f"joints/{j}/mode"] > 0)}
+    return Summary(peak["velocity"], peak["acceleration"], forces, shares, sticking)
 
 
 def _peak_contact_force(path: Path, joint: str, sampled: np.ndarray) -> float:

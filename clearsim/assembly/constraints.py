@@ -161,22 +161,36 @@ def jacobian_transpose_times(blocks, bodies, lam, n):
 
 @njit(cache=True)
 def schur_complement(blocks, bodies, minv):
-    """S = Φ_q M⁻¹ Φ_qᵀ from the blocks: rows couple only through a shared body."""
+    """S = Φ_q M⁻¹ Φ_qᵀ from the blocks: rows couple only through a shared body, so S is summed body by body."""
     m = blocks.shape[0]
+    nb = minv.shape[0] // 3
+    count = np.zeros(nb + 1, np.int64)
+    for row in range(m):
+        for slot in range(2):
+            if bodies[row, slot] >= 0:
+                count[bodies[row, slot] + 1] += 1
+    for b in range(nb):
+        count[b + 1] += count[b]
+    entries = np.empty((count[nb], 2), np.int64)  # (row, slot) of each block, grouped by body
+    filled = count[:nb].copy()
+    for row in range(m):
+        for slot in range(2):
+            b = bodies[row, slot]
+            if b >= 0:
+                entries[filled[b], 0], entries[filled[b], 1] = row, slot
+                filled[b] += 1
     schur = np.zeros((m, m))
-    for i in range(m):
-        for j in range(i + 1):
-            total = 0.0
-            for si in range(2):
-                b = bodies[i, si]
-                if b < 0:
-                    continue
-                for sj in range(2):
-                    if bodies[j, sj] == b:
-                        for c in range(3):
-                            total += blocks[i, si, c] * minv[3 * b + c] * blocks[j, sj, c]
-            schur[i, j] = total
-            schur[j, i] = total
+    for b in range(nb):
+        for e in range(count[b], count[b + 1]):
+            i, si = entries[e, 0], entries[e, 1]
+            for f in range(count[b], e + 1):
+                j, sj = entries[f, 0], entries[f, 1]
+                total = 0.0
+                for c in range(3):
+                    total += blocks[i, si, c] * minv[3 * b + c] * blocks[j, sj, c]
+                schur[i, j] += total
+                if i != j:
+                    schur[j, i] += total
     return schur
 
 

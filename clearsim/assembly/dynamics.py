@@ -52,13 +52,24 @@ def inverse_mass(system):
 
 @njit(cache=True)
 def cholesky_solve(matrix, rhs):
-    """Solve S x = b for symmetric positive definite S (small, dense); returns x (NaN if not SPD)."""
+    """Solve S x = b for symmetric positive definite S (small, dense); returns x (NaN if not SPD).
+
+    Envelope (skyline) Cholesky: row i of L starts where row i of S does (first[i]), since the
+    factor has no fill-in left of the envelope, so the zeros of a chain's S cost nothing.
+    """
     m = rhs.shape[0]
+    first = np.empty(m, np.int64)
+    for i in range(m):
+        first[i] = i
+        for j in range(i):
+            if matrix[i, j] != 0.0:
+                first[i] = j
+                break
     lower = np.zeros((m, m))
     for i in range(m):
-        for j in range(i + 1):
+        for j in range(first[i], i + 1):
             acc = matrix[i, j]
-            for k in range(j):
+            for k in range(max(first[i], first[j]), j):
                 acc -= lower[i, k] * lower[j, k]
             if i == j:
                 if acc <= 0.0:
@@ -68,12 +79,13 @@ def cholesky_solve(matrix, rhs):
                 lower[i, j] = acc / lower[j, j]
     x = rhs.copy()
     for i in range(m):
-        for k in range(i):
+        for k in range(first[i], i):
             x[i] -= lower[i, k] * x[k]
         x[i] /= lower[i, i]
     for i in range(m - 1, -1, -1):
         for k in range(i + 1, m):
-            x[i] -= lower[k, i] * x[k]
+            if first[k] <= i:
+                x[i] -= lower[k, i] * x[k]
         x[i] /= lower[i, i]
     return x
 

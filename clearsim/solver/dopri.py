@@ -35,6 +35,17 @@ DENSE = np.array([
 
 
 @njit(cache=True)
+def _accumulate(out, base, coefficients, h, stages, count):
+    """out = base + Σ_{j<count} (h a_j) K_j, skipping zero coefficients (no temporaries)."""
+    out[:] = base
+    for j in range(count):
+        if coefficients[j] != 0.0:
+            weight = h * coefficients[j]
+            for i in range(out.shape[0]):
+                out[i] += weight * stages[j, i]
+
+
+@njit(cache=True)
 def step(system, t, y, f, h, modes, speeds, stages, y_new):
     """One DOPRI5 step from (t, y) with ẏ(t) = f; fills stages (7, ny) and y_new; returns the error vector."""
     stages[0, :] = f
@@ -43,20 +54,12 @@ def step(system, t, y, f, h, modes, speeds, stages, y_new):
     # exactly there (the end of a stroke), and the step must see the piece it integrates over
     end = np.nextafter(t + h, t)
     for s in range(1, 6):
-        work[:] = y
-        for j in range(s):
-            if MATRIX[s, j] != 0.0:
-                work += h * MATRIX[s, j] * stages[j]
+        _accumulate(work, y, MATRIX[s], h, stages, s)
         rhs(system, min(t + NODES[s] * h, end), work, modes, speeds, stages[s])
-    y_new[:] = y
-    for j in range(6):
-        if WEIGHTS[j] != 0.0:
-            y_new += h * WEIGHTS[j] * stages[j]
+    _accumulate(y_new, y, WEIGHTS, h, stages, 6)
     rhs(system, end, y_new, modes, speeds, stages[6])
     error = np.zeros_like(y)
-    for j in range(STAGES):
-        if ERROR_WEIGHTS[j] != 0.0:
-            error += h * ERROR_WEIGHTS[j] * stages[j]
+    _accumulate(error, error, ERROR_WEIGHTS, h, stages, STAGES)
     return error
 
 

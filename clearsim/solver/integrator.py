@@ -48,6 +48,8 @@ SUBDIVISIONS = 4  # points per step at which the event functions are sampled
 PROJECTION_TOLERANCE = 1e-13  # m (rad): max |Φ| kept after each step
 DRIFT_LIMIT = 1e-8  # m: a projection that cannot get below this has lost the assembly
 SAFETY = 0.9
+PEAK_CANDIDATE = 0.9  # a step's sampled F_n maximum within 10 % of the peak so far is refined
+PEAK_RESOLUTION = 1e-5  # of the step: the peak's location error; F_n is flat there, so its error is ~1e-10
 NORMAL, TANGENTIAL = 0, 1  # the two event functions of a clearance joint
 SLIDE_HYSTERESIS = 1e-9  # m/s: ε_v of the sliding-stops event, far below any resolved sliding speed
 DECIDE_SPEED = 1e-6  # m/s: below it a contact tests whether it sticks (settle_friction)
@@ -327,8 +329,9 @@ def normal_force_at(system, k, y, stages, h, theta, modes, speeds, scratch):
 def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
     """Raise peak_force[k] to the largest F_n of the step: at 4 points, then at an interior maximum.
 
-    A peak between the sampled points is refined by golden-section search on the continuous
-    extension, so the peak contact force does not depend on where the steps happen to end.
+    A peak between the sampled points that could raise the peak so far is refined by golden-section
+    search on the continuous extension (to 1e-5 of the step), so the peak contact force does not
+    depend on where the steps happen to end.
     """
     golden = 0.5 * (np.sqrt(5.0) - 1.0)
     for k in range(modes.shape[0]):
@@ -339,13 +342,16 @@ def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
             force = normal_force_at(system, k, y, stages, h, i / SUBDIVISIONS, modes, speeds, scratch)
             if force > best:
                 best, best_theta = force, i / SUBDIVISIONS
+        if best_theta == 0.0 or best_theta == 1.0 or best < PEAK_CANDIDATE * peak_force[k]:
+            peak_force[k] = max(peak_force[k], best)
+            continue  # the step's force peaks at an end, or far below the peak so far: nothing to refine
         lo = max(best_theta - 1.0 / SUBDIVISIONS, 0.0)
         hi = min(best_theta + 1.0 / SUBDIVISIONS, 1.0)
         a, b = hi - golden * (hi - lo), lo + golden * (hi - lo)
         fa = normal_force_at(system, k, y, stages, h, a, modes, speeds, scratch)
         fb = normal_force_at(system, k, y, stages, h, b, modes, speeds, scratch)
         for _ in range(40):
-            if hi - lo < 1e-7:
+            if hi - lo < PEAK_RESOLUTION:
                 break
             if fa >= fb:
                 hi, b, fb = b, a, fa

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from clearsim.assembly.arrays import CL_EXPONENT, CL_MIN_IMPACT_SPEED, CL_STIFFNESS, OFF_DIRECTION
+from clearsim.assembly.forces import STICK
 from clearsim.assembly.dynamics import WORK_APPLIED, WORK_CONTACT, WORK_DAMPING, WORK_DRIVER, WORK_FRICTION
 from clearsim.assembly.system import SensorSpec, System
 from clearsim.solver.samples import C_ECC_X, C_ECC_Y, C_FRICTION, C_NORMAL, C_PENETRATION, C_RATE, C_SLIDING
@@ -87,6 +88,7 @@ def clearance_histories(system: System, chunk, modes: np.ndarray) -> dict:
         out[f"joints/{name}/friction_force"] = (contact[:, C_FRICTION], "N")
         out[f"joints/{name}/sliding_velocity"] = (contact[:, C_SLIDING], "m/s")
         out[f"joints/{name}/mode"] = (modes[:, k], "0 free, 1 impact, 2 contact")
+        out[f"joints/{name}/stick"] = ((chunk.modes[:, k] == STICK).astype(np.int8), "1 sticking (v_t = 0), 0 not")
     return out
 
 

@@ -1,8 +1,9 @@
 """Cases 6 and 5c of docs/validation.md: the seed paper's studies (Meng et al. 2015) on the reconstructed UHV
 model, and the UHV tolerance / output-rate study.
 
-    python docs/scripts/paper_studies.py [OUT] [--figures] [--workers N]   (sweep folders under OUT,
-                                                                          default /tmp/clearsim-paper)
+    python docs/scripts/paper_studies.py [OUT] [--figures] [--workers N] [--stick smooth|exact]
+        (sweep folders under OUT, default /tmp/clearsim-paper[-STICK]; --stick smooth: the friction law as
+        written, the stiction band through zero — the numbers of the session-2 text of §6)
 
 Runs the `clearsim sweep`s of SWEEPS on configs/uhv_breaker.yaml and prints, from their summary.csv and
 result files: the detailed table, the "paper vs clearsim" table, the start delay at several thresholds,
@@ -70,9 +71,18 @@ STICK_SPEED = 1e-4  # m/s: v_s of the file's stiction_step law; |v_t| below it c
 
 # ---------------------------------------------------------------- running the sweeps and reading their files
 
-def run_sweep(name, out, workers):
+def sweep_arguments(name, stick=None):
+    """The sweep's options; with `stick`, every friction law that sticks uses that treatment (exact is the default)."""
+    arguments = SWEEPS[name]
+    if stick is None:
+        return arguments
+    arguments = [a.replace("{law: coulomb, mu_d: 0.16}", f"{{law: coulomb, mu_d: 0.16, stick: {stick}}}") for a in arguments]
+    return ["--set", f"defaults.friction.stick={stick}", *arguments]
+
+
+def run_sweep(name, out, workers, stick=None):
     folder = out / name
-    command = ["clearsim", "sweep", str(CONFIG), *SWEEPS[name], "--out", str(folder), "--workers", str(workers)]
+    command = ["clearsim", "sweep", str(CONFIG), *sweep_arguments(name, stick), "--out", str(folder), "--workers", str(workers)]
     print(f"$ {' '.join(command)}", file=sys.stderr)
     subprocess.run(command, check=False, stdout=subprocess.DEVNULL)  # a failed case shows in its row
     with open(folder / "summary.csv", newline="") as handle:
@@ -82,8 +92,9 @@ def run_sweep(name, out, workers):
     return rows
 
 
-def command_text(name):
-    return " ".join(["clearsim sweep configs/uhv_breaker.yaml", *(f'"{a}"' if " " in a else a for a in SWEEPS[name])])
+def command_text(name, stick=None):
+    return " ".join(["clearsim sweep configs/uhv_breaker.yaml",
+                     *(f'"{a}"' if " " in a else a for a in sweep_arguments(name, stick))])
 
 
 def ideal_row(rows):
@@ -517,14 +528,16 @@ FIGURE_MAKERS = (response_figure, peak_figure, friction_figure, path_figure, ons
 def main():
     arguments = sys.argv[1:]
     workers = int(arguments[arguments.index("--workers") + 1]) if "--workers" in arguments else 2
-    positional = [a for i, a in enumerate(arguments) if not a.startswith("--") and (i == 0 or arguments[i - 1] != "--workers")]
-    out = Path(positional[0]) if positional else Path("/tmp/clearsim-paper")
+    positional = [a for i, a in enumerate(arguments)
+                  if not a.startswith("--") and (i == 0 or arguments[i - 1] not in ("--workers", "--stick"))]
+    stick = arguments[arguments.index("--stick") + 1] if "--stick" in arguments else None
+    out = Path(positional[0]) if positional else Path("/tmp/clearsim-paper" + (f"-{stick}" if stick else ""))
     out.mkdir(parents=True, exist_ok=True)
-    studies = {name: run_sweep(name, out, workers) for name in SWEEPS}
+    studies = {name: run_sweep(name, out, workers, stick) for name in SWEEPS}
     print_detailed_table(studies)
-    print("\nReproduce: `python docs/scripts/paper_studies.py`, i.e. the sweeps\n")
+    print("\nReproduce: `python docs/scripts/paper_studies.py" + (f" --stick {stick}" if stick else "") + "`, i.e. the sweeps\n")
     for name in SWEEPS:
-        print(f"- `{command_text(name)}`")
+        print(f"- `{command_text(name, stick)}`")
     print_paper_vs_clearsim(studies)
     print_start_delays(studies["a_and_j"])
     print_friction(studies)

@@ -78,6 +78,7 @@ def test_a_wheel_below_the_friction_angle_rolls_like_the_closed_form_pendulum(si
     assert np.max(np.abs(phi - expected)) <= 2e-3 * np.radians(6.0)
     assert np.all(result["joints/O/normal_force"] > 0)
     assert np.max(np.abs(result["joints/O/sliding_velocity"])) <= 1e-9  # it never slips
+    assert np.all(result["joints/O/stick"] == 1)
     # the stick constraint's multiplier is the friction force the closed form needs
     assert np.max(np.abs(result["joints/O/friction_force"] - friction)) <= 1e-2 * np.max(np.abs(friction))
     assert np.max(np.abs(friction) / normal) < MU_S  # precondition: the closed form never needs more than μ_s
@@ -99,6 +100,7 @@ def test_a_wheel_beyond_the_friction_angle_slides_at_the_friction_angle_and_spin
     late = result["time"] > 10e-3
     sliding = result["joints/O/sliding_velocity"][late]
     assert np.all(sliding > 1e-2)  # sliding, and faster than v_d: μ = μ_d
+    assert not np.any(result["joints/O/stick"][late])
     ratio = -result["joints/O/friction_force"][late] / result["joints/O/normal_force"][late]
     assert np.allclose(ratio, MU_D, rtol=1e-9, atol=0)
     phi = orbit_angle(result)[late]

@@ -47,9 +47,7 @@ class Candidate:
 
     def applied(self, document: dict, value: float) -> dict:
         """A copy of the document with the parameter set to `value`."""
-        changed = copy.deepcopy(document)
-        self.write(changed, float(value))
-        return changed
+        return with_effects(document, [self], [value])
 
     def grid(self, points: int) -> np.ndarray:
         """`points` values spread over the bounds (log-spaced for scale parameters), ends excluded."""
@@ -71,6 +69,14 @@ class Candidate:
     def shown(self, value: float) -> str:
         unit, scale = self.display_unit
         return f"{value / scale:.3g}{' ' + unit if unit else ''}"
+
+
+def with_effects(document: dict, candidates: list[Candidate], values) -> dict:
+    """A copy of the document with each candidate's parameter set to its value, in order."""
+    changed = copy.deepcopy(document)
+    for candidate, value in zip(candidates, values):
+        candidate.write(changed, float(value))
+    return changed
 
 
 KIND_TITLES = {"clearance": "clearance", "friction": "friction", "stiffness": "contact stiffness",

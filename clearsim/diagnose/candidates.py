@@ -35,6 +35,7 @@ class Candidate:
     current: float | None  # the parameter's value in the model as given (None: the effect is absent)
     write: Callable[[dict, float], None]  # puts a value into a document
     display_unit: tuple[str, float] = ("", 1.0)  # unit shown to engineers and the SI value of one of it
+    resonant: bool = False  # the parameter is a stiffness setting a resonance, frequency ∝ √value (search.resonance_seeds)
 
     @property
     def key(self) -> tuple[str, str | None, str]:
@@ -372,7 +373,7 @@ def compliance(mechanism, document) -> list[Candidate]:
             spring["damping"] = COMPLIANCE_DAMPING_RATIO * float(np.sqrt(value * split.mass))
 
         out.append(Candidate("compliance", body, "stiffness", "N/m", *COMPLIANCE_BOUNDS, True, None, write,
-                             ("MN/m", 1e6)))
+                             ("MN/m", 1e6), resonant=True))
     return out
 
 

@@ -5,6 +5,9 @@ smooth — impacts come and go as c changes — so the fit is a search on a grid
 around its best point, never a gradient method:
 
     screen   two values per candidate (at 30 % and 75 % of its range): is it visible at all, and how good?
+             For a stiffness that sets a resonance (a compliance), two more rounds of values whose
+             ringing frequency matches the record's residual peak (f ∝ √k): its cost is a narrow well
+             (a few % wide) that no grid finds
     scan     six more values over the range for the most promising candidates
     zoom     four, then two values between each of the two lowest local minima and their neighbours
     vertex   one value at the vertex of a parabola through the profile near its best point (the
@@ -29,6 +32,7 @@ import numpy as np
 from clearsim.diagnose.align import Fit, Record, chi_square_halves, fit_offset, predict, residuals
 from clearsim.diagnose.candidates import Candidate, with_effects
 from clearsim.diagnose.evaluate import Evaluator, Prediction
+from clearsim.diagnose.features import dominant_frequency
 
 SCREEN_POINTS = (0.3, 0.75)  # of the range (in log units for scale parameters)
 SCAN_POINTS = 6
@@ -38,6 +42,7 @@ SIGNIFICANCE = 10.0  # ΔBIC below −10: "very strong" evidence (Kass & Raftery
 TIE = 6.0  # BIC within 6 of the best: the data do not tell the two apart
 PROFILE_POINTS = 7  # points of the local parabola through the profile
 VISIBLE = 1.0  # |Δχ²| below 1 at both screening values: the sensors do not see the candidate
+RESONANCE_ROUNDS = 2  # rounds of frequency-matched values for a resonant candidate in screening
 REFIT_ROUNDS = 3
 REFIT_STEP = 0.04  # first stencil step of the joint refit, in unit coordinates (4 % of each range)
 REFIT_REACH = 2.0  # the quadratic's minimum is looked for within 2 steps of the best point
@@ -97,11 +102,39 @@ def score_point(record: Record, sensors: list[str], value: float, prediction: Pr
     return Point(value, fit, prediction)
 
 
-def screen(evaluator, record, sensors, candidates: list[Candidate], document) -> list[Scored]:
+def aligned_residuals(record: Record, prediction: Prediction, offset: float) -> dict[str, np.ndarray]:
+    """The record minus the prediction at trigger offset `offset`, both in the comparison band (D0)."""
+    return residuals(record, predict(record, prediction.time, {s: prediction.sensors[s] for s in record.values}, offset))
+
+
+def screen(evaluator, record, sensors, candidates: list[Candidate], document, baseline: Point) -> list[Scored]:
     scored = [Scored(c) for c in candidates]
     evaluate_points(evaluator, record, sensors, [(s, v) for s in scored for v in s.candidate.from_unit(SCREEN_POINTS)],
                     document)
+    resonant = [s for s in scored if s.candidate.resonant]
+    for _ in range(RESONANCE_ROUNDS if resonant else 0):
+        latest = {id(s): len(s.points) for s in resonant}
+        jobs = [(s, v) for s in resonant for v in resonance_seeds(record, baseline, s.points[-2:], s.candidate)]
+        evaluate_points(evaluator, record, sensors, jobs, document)
+        resonant = [s for s in resonant if len(s.points) > latest[id(s)]]
     return scored
+
+
+def resonance_seeds(record: Record, baseline: Point, points: list[Point], candidate: Candidate) -> list[float]:
+    """For each run, the value whose ringing would match the record's: k (f_record / f_run)², where f_record is the
+    peak of the residual of the model as given and f_run that of the run's change to the model (both in the
+    comparison band, at the model's trigger offset). New values only, within the bounds."""
+    base = aligned_residuals(record, baseline.prediction, baseline.fit.offset)
+    target = dominant_frequency(record, base)
+    seeds = []
+    for point in points:
+        if point.fit is None or target is None:
+            continue
+        change = aligned_residuals(record, point.prediction, baseline.fit.offset)
+        own = dominant_frequency(record, {s: base[s] - change[s] for s in base})
+        if own:
+            seeds.append(float(np.clip(point.value * (target / own) ** 2, candidate.low, candidate.high)))
+    return [v for v in dict.fromkeys(seeds) if v not in {p.value for p in points}]
 
 
 def seen_by_sensors(scored: Scored, baseline: float) -> bool:
@@ -221,12 +254,11 @@ def mark_ties(ranked: list[Scored], all_sensors_scale: dict[str, float]) -> None
                                                all_sensors_scale)
 
 
-def halves_improved(record: Record, sensors: list[str], baseline: Point, effect: Point) -> tuple[float, float]:
+def halves_improved(record: Record, baseline: Point, effect: Point) -> tuple[float, float]:
     """Δχ² of the effect over the model on each half of the record (both negative: the improvement
     is not carried by one part of the record alone — the split-record check of DESIGN.md §8)."""
     def halves(point: Point):
-        aligned = predict(record, point.prediction.time, {s: point.prediction.sensors[s] for s in sensors}, point.fit.offset)
-        return chi_square_halves(record, residuals(record, aligned))
+        return chi_square_halves(record, aligned_residuals(record, point.prediction, point.fit.offset))
 
     (base_first, base_second), (first, second) = halves(baseline), halves(effect)
     return first - base_first, second - base_second

@@ -236,14 +236,15 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     if not base_prediction.ok:
         raise DiagnoseError(f"{request.config}: the model does not run to the end ({base_prediction.error}); "
                             "fix it with `clearsim run` first")
-    baseline = score_point(record, sensors, 0.0, base_prediction).fit
+    base_point = score_point(record, sensors, 0.0, base_prediction)
+    baseline = base_point.fit
     aligned = predict(record, base_prediction.time, {s: base_prediction.sensors[s] for s in sensors}, baseline.offset)
     found_features = features(record, aligned, units)
     windows = disagreement_windows(record, residuals(record, aligned))
     say(f"iteration {number}: gap {baseline.gap:.3g} (trigger offset {baseline.offset * 1e3:.3f} ms), "
         f"{len(windows)} window(s) outside the noise band")
     candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds) if c.key not in found_keys]
-    scored = screen(evaluator, record, sensors, candidates, document)
+    scored = screen(evaluator, record, sensors, candidates, document, base_point)
     visible = [s for s in scored if seen_by_sensors(s, baseline.chi_square)]
     chosen = to_fit(visible, baseline, record, request.fit_top)
     say(f"  screened {len(candidates)} candidates ({len(visible)} visible to the sensors); fitting "
@@ -253,7 +254,7 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
     if winner is not None:
         mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
-        winner.halves = halves_improved(record, sensors, score_point(record, sensors, 0.0, base_prediction), winner.estimate)
+        winner.halves = halves_improved(record, base_point, winner.estimate)
         say(f"  found: {effect_line(found_effect(winner, baseline))}")
     else:
         say("  no candidate beats the model significantly")

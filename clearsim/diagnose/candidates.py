@@ -9,12 +9,19 @@ document (a dict, edited in place). To add a kind, write one function `kind(mech
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from functools import partial
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
-from clearsim.assembly.build import initial_poses, joint_points
+from clearsim.assembly.build import BuildError, initial_poses, joint_points
+from clearsim.assembly.dynamics import accelerations, generalized_forces
+from clearsim.assembly.system import assemble
+from clearsim.diagnose.evaluate import document_text
+from clearsim.errors import ClearsimError
+from clearsim.model.loader import load_mechanism_text
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.resolve import is_clearance_joint, resolve_clearance
 from clearsim.model.schema import Mechanism, PrismaticJoint, SpringDamper, StrokeMotion
@@ -257,6 +264,7 @@ class LinkSplit:
     moved_sensors: frozenset  # point sensors nearer the second joint
     moved_ends: dict  # force name → indices of its ends on the body nearer the second joint (single-body force: (0,))
     mass: float  # kg, of the whole link
+    tension: float = 0.0  # N: the rigid link's axial tension at t = 0, carried by the spring from the start
 
     @property
     def guide(self) -> str:
@@ -265,6 +273,10 @@ class LinkSplit:
     @property
     def spring(self) -> str:
         return f"{self.body}_compliance"
+
+    @property
+    def length(self) -> float:
+        return float(np.hypot(self.far[0] - self.near[0], self.far[1] - self.near[1]))
 
 
 def _two_joint_links(mechanism) -> list[tuple[str, list]]:
@@ -351,18 +363,39 @@ def split_link(document: dict, split: LinkSplit) -> None:
                                "at": list(split.near), "axis": (axis / np.linalg.norm(axis)).tolist()})
     document["forces"] = (document.get("forces") or []) + [{
         "type": "spring_damper", "name": split.spring, "bodies": [split.body, split.half],
-        "at": [list(split.near), list(split.far)], "stiffness": 0.0, "damping": 0.0,
-        "free_length": float(np.linalg.norm(axis))}]
+        "at": [list(split.near), list(split.far)], "stiffness": 0.0, "damping": 0.0, "free_length": split.length}]
 
 
-def compliance(mechanism, document) -> list[Candidate]:
+def initial_tension(document: dict, split: LinkSplit, base_dir: Path) -> float:
+    """The link's axial tension at t = 0 in the model as given: the split with its slide locked by a driver
+    (the rigid link again), assembled, and the lock's multiplier at t = 0 (the force along the link on the
+    second half is −λ·axis, as a spring's tension λ). 0 when that model cannot be assembled."""
+    locked = copy.deepcopy(document)
+    split_link(locked, split)
+    lock = f"{split.guide}_lock"
+    locked["drivers"] = (locked.get("drivers") or []) + [
+        {"name": lock, "joint": split.guide, "motion": {"law": "polynomial", "coefficients": [0.0]}}]
+    try:
+        system = assemble(load_mechanism_text(document_text(locked), "compliance", (), base_dir).mechanism, base_dir)
+    except (BuildError, ClearsimError, ValueError):
+        return 0.0
+    contacts = len(system.clearance_joints)
+    forces = generalized_forces(system.arrays, 0.0, system.q0, system.qd0, np.zeros(contacts, np.int64),
+                                np.zeros(contacts))[0]
+    multipliers = accelerations(system.arrays, 0.0, system.q0, system.qd0, forces)[1]
+    return float(multipliers[dict(system.drivers)[lock]])
+
+
+def compliance(mechanism, document, base_dir: Path = Path(".")) -> list[Candidate]:
     """Axial stiffness k of each two-joint link: the link split in two halves along the line between
-    its joints, joined by a prismatic joint and a spring-damper k, c = ζ √(k m) (ζ = 2 %)."""
+    its joints, joined by a prismatic joint and a spring-damper k, c = ζ √(k m) (ζ = 2 %), whose free
+    length L − T₀/k makes it carry the rigid link's tension T₀ at t = 0 (no start transient)."""
     out = []
     for body, joints in _two_joint_links(mechanism):
         split = link_split(mechanism, body, joints)
         if split is None:
             continue
+        split = replace(split, tension=initial_tension(document, split, base_dir))
 
         def write(doc, value, split=split):
             spring = next((f for f in doc.get("forces") or [] if f.get("name") == split.spring), None)
@@ -371,6 +404,7 @@ def compliance(mechanism, document) -> list[Candidate]:
                 spring = doc["forces"][-1]
             spring["stiffness"] = float(value)
             spring["damping"] = COMPLIANCE_DAMPING_RATIO * float(np.sqrt(value * split.mass))
+            spring["free_length"] = split.length - split.tension / float(value)
 
         out.append(Candidate("compliance", body, "stiffness", "N/m", *COMPLIANCE_BOUNDS, True, None, write,
                              ("MN/m", 1e6), resonant=True))
@@ -382,5 +416,7 @@ KINDS: dict[str, Callable] = {"clearance": clearance, "friction": friction, "sti
                               "compliance": compliance}
 
 
-def candidates_for(mechanism, document: dict, kinds: list[str]) -> list[Candidate]:
-    return [c for kind in kinds for c in KINDS[kind](mechanism, document)]
+def candidates_for(mechanism, document: dict, kinds: list[str], base_dir: Path | str = ".") -> list[Candidate]:
+    """The candidates of the kinds; `base_dir`: where the file's tables are (a compliance assembles the model)."""
+    makers = {**KINDS, "compliance": partial(compliance, base_dir=Path(base_dir))}
+    return [c for kind in kinds for c in makers[kind](mechanism, document)]

@@ -243,7 +243,7 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     windows = disagreement_windows(record, residuals(record, aligned))
     say(f"iteration {number}: gap {baseline.gap:.3g} (trigger offset {baseline.offset * 1e3:.3f} ms), "
         f"{len(windows)} window(s) outside the noise band")
-    candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds) if c.key not in found_keys]
+    candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds, Path(request.config).parent) if c.key not in found_keys]
     scored = screen(evaluator, record, sensors, candidates, document, base_point)
     visible = [s for s in scored if seen_by_sensors(s, baseline.chi_square)]
     chosen = to_fit(visible, baseline, record, request.fit_top)

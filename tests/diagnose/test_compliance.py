@@ -69,7 +69,7 @@ def test_the_split_keeps_every_name_and_redirects_by_where_things_attach(tmp_pat
     halves = [mechanism.body("insulating_pole"), mechanism.body("insulating_pole_G_half")]
     assert sum(b.mass for b in halves) == pytest.approx(81.54) and sum(b.inertia for b in halves) == pytest.approx(0.051)
     spring = next(f for f in mechanism.forces if f.name == "insulating_pole_compliance")
-    assert spring.stiffness == 3e7 and spring.free_length == pytest.approx(2.0)
+    assert spring.stiffness == 3e7 and 2.0 - 1e-4 < spring.free_length < 2.0  # pulled down at t = 0: the pole is in tension
     assert spring.damping == pytest.approx(COMPLIANCE_DAMPING_RATIO * np.sqrt(3e7 * 81.54))
 
 
@@ -79,10 +79,14 @@ def _sensors(path: Path, config: Path, overrides=()) -> dict:
     return {name.split("/", 1)[1]: values for name, values in result.items() if name.startswith("sensors/")}
 
 
+STIFF_LIMIT = {"slider_displacement": 1e-5, "slider_velocity": 1e-4, "slider_acceleration": 1e-2, "pin_normal_force": 1e-2}
+
+
 def test_a_stiff_split_link_is_the_rigid_link_and_a_soft_one_is_not(tmp_path):
-    """Displacement and velocity of the slider with the rod split at the stiffest bound agree with the rigid rod to
-    1e-5 and 3e-3 of their ranges; at 10 MN/m they differ visibly (the spring is in the load path). Accelerations
-    and forces are not compared: the spring starts unloaded, so the loaded rod rings for a few periods at the start."""
+    """The slider's displacement, velocity and acceleration and the rod-slider pin force with the rod split at the
+    stiffest bound agree with the rigid rod's to STIFF_LIMIT of their ranges over the whole run, the start included
+    (the spring carries the rod's load at t = 0; unloaded, the rod rang with the full load amplitude there); at
+    10 MN/m they differ visibly (the spring is in the load path)."""
     rigid = _sensors(tmp_path / "rigid.h5", SLIDER_CRANK, IDEAL)
     document, candidate = compliance_of(SLIDER_CRANK, "rod", IDEAL)
     differences = {}
@@ -90,11 +94,9 @@ def test_a_stiff_split_link_is_the_rigid_link_and_a_soft_one_is_not(tmp_path):
         path = tmp_path / f"split-{k:g}.yaml"
         path.write_text(document_text(candidate.applied(document, k)))
         split = _sensors(tmp_path / f"split-{k:g}.h5", path)
-        differences[k] = {s: float(np.max(np.abs(split[s] - rigid[s])) / np.ptp(rigid[s]))
-                          for s in ("slider_displacement", "slider_velocity")}
-    assert differences[candidate.high]["slider_displacement"] < 1e-5
-    assert differences[candidate.high]["slider_velocity"] < 3e-3
-    assert differences[1e7]["slider_displacement"] > 3e-3 and differences[1e7]["slider_velocity"] > 2e-2
+        differences[k] = {s: float(np.max(np.abs(split[s] - rigid[s])) / np.ptp(rigid[s])) for s in STIFF_LIMIT}
+    assert all(differences[candidate.high][s] < limit for s, limit in STIFF_LIMIT.items()), differences
+    assert all(differences[1e7][s] > limit for s, limit in STIFF_LIMIT.items()), differences
 
 
 def diagnose_hidden(folder: Path, config: Path, body: str, overrides: list[str], truth: float, bench: list,
@@ -143,9 +145,9 @@ UHV_FRICTIONLESS = ["defaults.friction={law: none}", "joints.A.clearance=0", "jo
 
 @pytest.mark.slow
 def test_a_hidden_compliance_of_the_uhv_pole_is_found_by_its_ringing(tmp_path):
-    """The 2 m insulating pole at 30 MN/m rings at ~93 Hz after the drive starts, seen by the moving contact's
-    sensors: a gap of ~150 noise levels, in a cost well only ±5 % wide in k that no grid of the range hits; the
-    frequency-matched screening values find it."""
+    """The 2 m insulating pole at 30 MN/m rings at ~93 Hz, seen by the moving contact's sensors (gap ~22). Its cost
+    is a well about ±10 % wide in k (gap 1.05 at the truth, ~8 at ±10 %); without the frequency-matched screening
+    values the grid and zooms settle on the lower linking board's compliance instead (checked)."""
     truth = 30e6
     found = diagnose_hidden(tmp_path, UHV, "insulating_pole", UHV_FRICTIONLESS, truth,
                             ["--sensors", "contact_displacement,contact_velocity", "--rate", "15kHz", "--noise", "0.05%",

@@ -9,14 +9,22 @@ document (a dict, edited in place). To add a kind, write one function `kind(mech
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from functools import partial
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
+from clearsim.assembly.build import BuildError, initial_poses, joint_points
+from clearsim.assembly.dynamics import accelerations, generalized_forces
+from clearsim.assembly.system import assemble
+from clearsim.diagnose.evaluate import document_text
+from clearsim.errors import ClearsimError
+from clearsim.model.loader import load_mechanism_text
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.resolve import is_clearance_joint, resolve_clearance
-from clearsim.model.schema import Mechanism, StrokeMotion
+from clearsim.model.schema import Mechanism, PrismaticJoint, SpringDamper, StrokeMotion
 from clearsim.units import to_si
 
 FAR_ANCHOR = 1000.0  # m: a damper anchored this far along its line acts in a fixed direction
@@ -34,6 +42,7 @@ class Candidate:
     current: float | None  # the parameter's value in the model as given (None: the effect is absent)
     write: Callable[[dict, float], None]  # puts a value into a document
     display_unit: tuple[str, float] = ("", 1.0)  # unit shown to engineers and the SI value of one of it
+    resonant: bool = False  # the parameter is a stiffness setting a resonance, frequency ∝ √value (search.resonance_seeds)
 
     @property
     def key(self) -> tuple[str, str | None, str]:
@@ -46,9 +55,7 @@ class Candidate:
 
     def applied(self, document: dict, value: float) -> dict:
         """A copy of the document with the parameter set to `value`."""
-        changed = copy.deepcopy(document)
-        self.write(changed, float(value))
-        return changed
+        return with_effects(document, [self], [value])
 
     def grid(self, points: int) -> np.ndarray:
         """`points` values spread over the bounds (log-spaced for scale parameters), ends excluded."""
@@ -72,8 +79,17 @@ class Candidate:
         return f"{value / scale:.3g}{' ' + unit if unit else ''}"
 
 
+def with_effects(document: dict, candidates: list[Candidate], values) -> dict:
+    """A copy of the document with each candidate's parameter set to its value, in order."""
+    changed = copy.deepcopy(document)
+    for candidate, value in zip(candidates, values):
+        candidate.write(changed, float(value))
+    return changed
+
+
 KIND_TITLES = {"clearance": "clearance", "friction": "friction", "stiffness": "contact stiffness",
-               "restitution": "restitution", "drive": "drive", "damping": "viscous damping", "mass": "mass"}
+               "restitution": "restitution", "drive": "drive", "damping": "viscous damping", "mass": "mass",
+               "compliance": "axial compliance"}
 JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution"}
 
 
@@ -227,9 +243,180 @@ def mass(mechanism, document) -> list[Candidate]:
     return out
 
 
+COMPLIANCE_BOUNDS = (1e6, 1e10)  # N/m: a soft composite pull rod (≈ 1 MN/m) to a short steel link (≈ 10 GN/m)
+COMPLIANCE_DAMPING_RATIO = 0.02  # structural damping of the axial mode, 2 % of critical (bolted steel, GFRP: 1–5 %)
+
+
+@dataclass(frozen=True)
+class LinkSplit:
+    """How a two-joint link becomes two halves sliding along the line between its joints.
+
+    The half at the first joint (in file order) keeps the body's name; the other is new. Both start
+    with the body's pose, centre of mass and body points, half its mass and half its inertia, so the
+    pair has the link's mass, centre of mass and inertia, and a stiff spring gives the rigid link back.
+    """
+
+    body: str
+    half: str  # the new body, at the second joint
+    near: tuple[float, float]  # global location of the first joint at t = 0
+    far: tuple[float, float]  # of the second
+    moved_joint: str  # the second joint: its reference to the body goes to the new half
+    moved_sensors: frozenset  # point sensors nearer the second joint
+    moved_ends: dict  # force name → indices of its ends on the body nearer the second joint (single-body force: (0,))
+    mass: float  # kg, of the whole link
+    tension: float = 0.0  # N: the rigid link's axial tension at t = 0, carried by the spring from the start
+
+    @property
+    def guide(self) -> str:
+        return f"{self.body}_stretch"
+
+    @property
+    def spring(self) -> str:
+        return f"{self.body}_compliance"
+
+    @property
+    def length(self) -> float:
+        return float(np.hypot(self.far[0] - self.near[0], self.far[1] - self.near[1]))
+
+
+def _two_joint_links(mechanism) -> list[tuple[str, list]]:
+    """Bodies with exactly two revolute joints, in no prismatic joint and driven by no body driver."""
+    revolute = {b.name: [] for b in mechanism.bodies}
+    excluded = {d.body for d in mechanism.drivers if d.body is not None}
+    for joint in mechanism.joints:
+        for name in set(joint.bodies) & set(revolute):
+            if isinstance(joint, PrismaticJoint):
+                excluded.add(name)
+            else:
+                revolute[name].append(joint)
+    return [(name, joints) for name, joints in revolute.items() if len(joints) == 2 and name not in excluded]
+
+
+def _joint_location(mechanism, poses, joint, body: str) -> np.ndarray:
+    """Where the joint sits on `body`, globally, at t = 0 (as the assembly reads `at:` or `points:`)."""
+    _, _, si, sj = joint_points(poses, joint, ("joints", mechanism.joints.index(joint)))
+    return poses.to_global(poses.index[body], si if joint.bodies[0] == body else sj)
+
+
+def _force_ends(poses, force, body: str) -> list[tuple[int, np.ndarray]]:
+    """(end index, global location at t = 0) of each end of a force that acts on `body`."""
+    index = poses.index[body]
+    if not isinstance(force, SpringDamper):
+        return [(0, poses.point_global(force.point, index, ()))] if force.body == body else []
+    ends = []
+    for end, name in enumerate(force.bodies):
+        if name != body:
+            continue
+        if force.points is not None:
+            ends.append((end, poses.to_global(index, poses.named_body_point(body, force.points[end], ())[0])))
+        else:
+            ends.append((end, poses.point_global(force.at[end] if force.at is not None else None, index, ())))
+    return ends
+
+
+def link_split(mechanism, body: str, joints: list) -> LinkSplit | None:
+    """The split of a two-joint link; None when its joints coincide or the new names are taken."""
+    poses = initial_poses(mechanism)
+    near, far = (_joint_location(mechanism, poses, j, body) for j in joints)
+    axis = far - near
+    if np.linalg.norm(axis) < 1e-9:
+        return None
+
+    def nearer_far(point) -> bool:
+        return float(np.dot(np.asarray(point, float) - near, axis)) > 0.5 * float(np.dot(axis, axis))
+
+    sensors = frozenset(s.name for s in mechanism.sensors if getattr(s, "body", None) == body and hasattr(s, "point")
+                        and nearer_far(poses.point_global(s.point, poses.index[body], ())))
+    moved = {f.name: tuple(end for end, where in _force_ends(poses, f, body) if nearer_far(where)) for f in mechanism.forces}
+    split = LinkSplit(body, f"{body}_{joints[1].name}_half", tuple(near.tolist()), tuple(far.tolist()), joints[1].name, sensors,
+                      {name: ends for name, ends in moved.items() if ends}, mechanism.body(body).mass)
+    taken = {b.name for b in mechanism.bodies} | {j.name for j in mechanism.joints} | {f.name for f in mechanism.forces}
+    return None if {split.half, split.guide, split.spring} & taken else split
+
+
+def split_link(document: dict, split: LinkSplit) -> None:
+    """Make the link two halves joined by a prismatic joint along it and a spring-damper (no force yet)."""
+    bodies = document["bodies"]
+    position = next(i for i, b in enumerate(bodies) if b["name"] == split.body)
+    near = bodies[position]
+    near["mass"] = to_si(near["mass"], "mass") / 2.0
+    near["inertia"] = to_si(near["inertia"], "inertia") / 2.0
+    bodies.insert(position + 1, {**copy.deepcopy(near), "name": split.half})
+
+    def moved(names, ends):
+        return [split.half if k in ends and n == split.body else n for k, n in enumerate(names)]
+
+    for joint in document["joints"]:
+        if joint["name"] == split.moved_joint:
+            joint["bodies"] = moved(joint["bodies"], (0, 1))
+    for sensor in document.get("sensors") or []:
+        if sensor["name"] in split.moved_sensors:
+            sensor["body"] = split.half
+    for force in document.get("forces") or []:
+        ends = split.moved_ends.get(force["name"], ())
+        if ends and "body" in force:
+            force["body"] = split.half
+        elif ends:
+            force["bodies"] = moved(force["bodies"], ends)
+    axis = np.subtract(split.far, split.near)
+    document["joints"].append({"name": split.guide, "type": "prismatic", "bodies": [split.body, split.half],
+                               "at": list(split.near), "axis": (axis / np.linalg.norm(axis)).tolist()})
+    document["forces"] = (document.get("forces") or []) + [{
+        "type": "spring_damper", "name": split.spring, "bodies": [split.body, split.half],
+        "at": [list(split.near), list(split.far)], "stiffness": 0.0, "damping": 0.0, "free_length": split.length}]
+
+
+def initial_tension(document: dict, split: LinkSplit, base_dir: Path) -> float:
+    """The link's axial tension at t = 0 in the model as given: the split with its slide locked by a driver
+    (the rigid link again), assembled, and the lock's multiplier at t = 0 (the force along the link on the
+    second half is −λ·axis, as a spring's tension λ). 0 when that model cannot be assembled."""
+    locked = copy.deepcopy(document)
+    split_link(locked, split)
+    lock = f"{split.guide}_lock"
+    locked["drivers"] = (locked.get("drivers") or []) + [
+        {"name": lock, "joint": split.guide, "motion": {"law": "polynomial", "coefficients": [0.0]}}]
+    try:
+        system = assemble(load_mechanism_text(document_text(locked), "compliance", (), base_dir).mechanism, base_dir)
+    except (BuildError, ClearsimError, ValueError):
+        return 0.0
+    contacts = len(system.clearance_joints)
+    forces = generalized_forces(system.arrays, 0.0, system.q0, system.qd0, np.zeros(contacts, np.int64),
+                                np.zeros(contacts))[0]
+    multipliers = accelerations(system.arrays, 0.0, system.q0, system.qd0, forces)[1]
+    return float(multipliers[dict(system.drivers)[lock]])
+
+
+def compliance(mechanism, document, base_dir: Path = Path(".")) -> list[Candidate]:
+    """Axial stiffness k of each two-joint link: the link split in two halves along the line between
+    its joints, joined by a prismatic joint and a spring-damper k, c = ζ √(k m) (ζ = 2 %), whose free
+    length L − T₀/k makes it carry the rigid link's tension T₀ at t = 0 (no start transient)."""
+    out = []
+    for body, joints in _two_joint_links(mechanism):
+        split = link_split(mechanism, body, joints)
+        if split is None:
+            continue
+        split = replace(split, tension=initial_tension(document, split, base_dir))
+
+        def write(doc, value, split=split):
+            spring = next((f for f in doc.get("forces") or [] if f.get("name") == split.spring), None)
+            if spring is None:
+                split_link(doc, split)
+                spring = doc["forces"][-1]
+            spring["stiffness"] = float(value)
+            spring["damping"] = COMPLIANCE_DAMPING_RATIO * float(np.sqrt(value * split.mass))
+            spring["free_length"] = split.length - split.tension / float(value)
+
+        out.append(Candidate("compliance", body, "stiffness", "N/m", *COMPLIANCE_BOUNDS, True, None, write,
+                             ("MN/m", 1e6), resonant=True))
+    return out
+
+
 KINDS: dict[str, Callable] = {"clearance": clearance, "friction": friction, "stiffness": stiffness,
-                              "restitution": restitution, "drive": drive, "damping": damping, "mass": mass}
+                              "restitution": restitution, "drive": drive, "damping": damping, "mass": mass,
+                              "compliance": compliance}
 
 
-def candidates_for(mechanism, document: dict, kinds: list[str]) -> list[Candidate]:
-    return [c for kind in kinds for c in KINDS[kind](mechanism, document)]
+def candidates_for(mechanism, document: dict, kinds: list[str], base_dir: Path | str = ".") -> list[Candidate]:
+    """The candidates of the kinds; `base_dir`: where the file's tables are (a compliance assembles the model)."""
+    makers = {**KINDS, "compliance": partial(compliance, base_dir=Path(base_dir))}
+    return [c for kind in kinds for c in makers[kind](mechanism, document)]

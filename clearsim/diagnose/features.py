@@ -95,3 +95,22 @@ def disagreement_windows(record: Record, residual: dict[str, np.ndarray]) -> lis
             out.append(Window(sensor, float(record.time[start]), float(record.time[stop - 1]),
                               float(level[start:stop].max())))
     return sorted(out, key=lambda w: -w.peak)
+
+
+RESONANCE_CYCLES = 3.0  # a resonance rings at least 3 cycles over the record; slower content is the quasi-static part
+SPECTRUM_PADDING = 16  # zero padding of the spectrum: peaks located to 1/16 of the record's frequency resolution
+
+
+def dominant_frequency(record: Record, signals: dict[str, np.ndarray]) -> float | None:
+    """Frequency of the highest peak of the summed spectra of `signals` (each in noise levels, Hann window)
+    between RESONANCE_CYCLES per record and the comparison band: the ringing a stiffness sets. None: no content."""
+    n = len(record.time)
+    frequencies = np.fft.rfftfreq(SPECTRUM_PADDING * n, 1.0 / record.rate)
+    window = np.hanning(n)
+    power = sum(np.abs(np.fft.rfft(window * (v - v.mean()) / record.noise[s].std, SPECTRUM_PADDING * n)) ** 2
+                for s, v in signals.items())
+    duration = record.time[-1] - record.time[0]
+    keep = np.flatnonzero((frequencies > RESONANCE_CYCLES / duration) & (frequencies < (record.cutoff or record.rate / 2)))
+    if keep.size == 0 or not np.any(power[keep] > 0.0):
+        return None
+    return float(frequencies[keep[np.argmax(power[keep])]])

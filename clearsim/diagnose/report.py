@@ -12,22 +12,32 @@ import numpy as np
 
 from clearsim.diagnose.align import predict, residuals
 from clearsim.diagnose.evaluate import document_text
-from clearsim.diagnose.search import Scored
-from clearsim.diagnose.workflow import Diagnosis, effect_line
+from clearsim.diagnose.search import JointFit, Scored
+from clearsim.diagnose.workflow import Diagnosis, Effect, effect_line, found_effect, refit_line
 from clearsim.io.hdf5 import keep_existing
 
 REPORT, JSON = "report.md", "diagnosis.json"
 
 
-def _effect(scored: Scored) -> dict:
-    c = scored.candidate
-    low, high = scored.interval
-    return {"kind": c.kind, "target": c.target, "parameters": {c.parameter: scored.estimate.value},
+def _effect(effect: Effect) -> dict:
+    c, scored = effect.candidate, effect.scored
+    low, high = effect.interval
+    return {"kind": c.kind, "target": c.target, "parameters": {c.parameter: effect.value},
             "interval": {c.parameter: [low, high]}, "unit": {c.parameter: c.unit},
             "ambiguous_with": scored.ambiguous_with, "telling_sensor": scored.telling_sensor,
-            "delta_bic": scored.delta_bic, "gap": scored.estimate.fit.gap,
+            "delta_bic": scored.delta_bic, "gap": effect.point.fit.gap,
             "delta_chi_square_halves": list(scored.halves) if scored.halves else None,
             "confirmed_on_both_halves": bool(scored.halves and max(scored.halves) < 0.0)}
+
+
+def _joint(joint: JointFit | None) -> dict | None:
+    """The joint refit: the greedy start, the refitted values, every run ([values…, χ²])."""
+    if joint is None:
+        return None
+    return {"effects": [f"{c.kind} {c.target} {c.parameter}" for c in joint.candidates],
+            "greedy": list(joint.start), "refitted": list(joint.best.value),
+            "gap_greedy": joint.start_point.fit.gap, "gap_refitted": joint.best.fit.gap, "last_step_unit": joint.step,
+            "runs": [[*p.value, p.chi_square if p.fit is not None else None] for p in joint.points]}
 
 
 def _ranking(scored: list[Scored]) -> list[dict]:
@@ -56,7 +66,8 @@ def diagnosis_document(d: Diagnosis) -> dict:
         "noise": {s: {"std": n.std, "effective_samples": n.effective_samples, "samples": n.samples}
                   for s, n in d.record.noise.items()},
         "comparison_lowpass_hz": d.record.cutoff,
-        "iterations": [{"gap": it.baseline.gap, "found": _effect(it.found) if it.found else None,
+        "joint_refit": _joint(d.joint),
+        "iterations": [{"gap": it.baseline.gap, "found": _effect(found_effect(it.found, it.baseline)) if it.found else None,
                         "ranking": _ranking(it.ranked),
                         "windows": [{"sensor": w.sensor, "start_s": w.start, "end_s": w.end, "peak_noise_levels": w.peak}
                                     for w in it.windows]} for it in d.iterations],
@@ -68,8 +79,7 @@ def augmented_yaml(d: Diagnosis) -> str:
     """The model with the effects found, as YAML, with a comment naming each one."""
     lines = [f"# {Path(d.request.config).name} with the effects found by clearsim diagnose "
              f"from {Path(d.request.measured).name}:"]
-    lines += [f"#   {i}. {effect_line(s, it.baseline)}" for i, (s, it) in
-              enumerate(((it.found, it) for it in d.iterations if it.found), start=1)] or ["#   (none)"]
+    lines += [f"#   {i}. {effect_line(e)}" for i, e in enumerate(d.effects, start=1)] or ["#   (none)"]
     if d.request.overrides:
         lines.append(f"# starting model: --set {' '.join(d.request.overrides)}")
     return "\n".join(lines) + "\n" + document_text(d.final)
@@ -105,7 +115,7 @@ def verdict(d: Diagnosis) -> str:
     if not d.effects:
         return (f"no missing effect found: no candidate lowers the BIC by more than the significance margin; "
                 f"gap {d.before.gap:.3g}")
-    return "; ".join(f"missing effect: {effect_line(s, it.baseline)}" for it in d.iterations if (s := it.found))
+    return "; ".join(f"missing effect: {effect_line(e)}" for e in d.effects)
 
 
 def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
@@ -118,7 +128,7 @@ def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
         out.append(f"| {s} | {n.std:.3g} {d.units.get(s, '')} | {n.effective_samples:.0f} / {n.samples} | "
                    f"{d.before.gaps[s]:.3g} | {d.after.gaps[s]:.3g} |")
     out += [f"| combined | | | {d.before.gap:.3g} | {d.after.gap:.3g} |", "",
-            f"Trigger offset: {d.before.offset * 1e3:.3f} ms (fitted as a nuisance).", "",
+            f"Trigger offset: {d.before.offset * 1e3:.3f} ms (fitted as a nuisance).", "", *_joint_lines(d),
             "## Where the model and the record disagree (before)", "",
             "| sensor | feature | measured | model | unit |", "|---|---|---|---|---|"]
     out += [f"| {f.sensor} | {f.name} | {f.measured:.4g} | {f.model:.4g} | {f.unit} |" for f in d.iterations[0].features]
@@ -139,6 +149,14 @@ def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
     out += ["## Figures", ""] + [f"![{p.stem}]({p.name})" for p in figures]
     out += ["", f"Augmented model: `{model_path.name}`.", ""]
     return "\n".join(out)
+
+
+def _joint_lines(d: Diagnosis) -> list[str]:
+    if d.joint is None:
+        return []
+    return [f"The {len(d.effects)} effects were found one after another, then {refit_line(d.joint, d.effects)}. "
+            "The values, intervals and gaps above are the refitted ones; ΔBIC is the evidence of the step that "
+            "found each effect.", ""]
 
 
 def _figures(d: Diagnosis, fmt: str) -> list[Path]:
@@ -175,7 +193,7 @@ def _figures(d: Diagnosis, fmt: str) -> list[Path]:
     rank_ax.barh([s.candidate.label for s in ranked][::-1], [s.delta_bic for s in ranked][::-1])
     rank_ax.axvline(-10, color="k", ls=":", lw=0.8)
     rank_ax.set_xlabel("ΔBIC vs the model as given (below −10: significant)")
-    gaps = [d.before.gap] + [s.estimate.fit.gap for s in d.effects]
+    gaps = [d.before.gap] + [e.point.fit.gap for e in d.effects]
     gap_ax.plot(range(len(gaps)), gaps, "o-")
     gap_ax.set_xticks(range(len(gaps)), ["as given"] + [s.candidate.label for s in d.effects], rotation=15)
     gap_ax.set_ylabel("combined gap")

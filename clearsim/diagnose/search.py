@@ -5,10 +5,18 @@ smooth — impacts come and go as c changes — so the fit is a search on a grid
 around its best point, never a gradient method:
 
     screen   two values per candidate (at 30 % and 75 % of its range): is it visible at all, and how good?
+             For a stiffness that sets a resonance (a compliance), two more rounds of values whose
+             ringing frequency matches the record's residual peak (f ∝ √k): its cost is a narrow well
+             (a few % wide) that no grid finds
     scan     six more values over the range for the most promising candidates
     zoom     four, then two values between each of the two lowest local minima and their neighbours
     vertex   one value at the vertex of a parabola through the profile near its best point (the
              minimum with the chaotic scatter of single runs smoothed out)
+
+After greedy selection has found several effects, `refit_jointly` refits all their values together
+(each was fitted with the earlier ones held at their own single-effect fits, which biases them):
+a stencil around the best values in the candidates' unit coordinates, a quadratic surface through it
+and a run at its minimum, the step halved each round.
 
 Candidates are ranked by the Bayesian information criterion BIC = χ²_min + k ln n_eff (k = 1 fitted
 parameter; the trigger offset is fitted in every model alike), so a candidate must lower χ² by more
@@ -22,8 +30,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from clearsim.diagnose.align import Fit, Record, chi_square_halves, fit_offset, predict, residuals
-from clearsim.diagnose.candidates import Candidate
+from clearsim.diagnose.candidates import Candidate, with_effects
 from clearsim.diagnose.evaluate import Evaluator, Prediction
+from clearsim.diagnose.features import dominant_frequency
 
 SCREEN_POINTS = (0.3, 0.75)  # of the range (in log units for scale parameters)
 SCAN_POINTS = 6
@@ -33,11 +42,15 @@ SIGNIFICANCE = 10.0  # ΔBIC below −10: "very strong" evidence (Kass & Raftery
 TIE = 6.0  # BIC within 6 of the best: the data do not tell the two apart
 PROFILE_POINTS = 7  # points of the local parabola through the profile
 VISIBLE = 1.0  # |Δχ²| below 1 at both screening values: the sensors do not see the candidate
+RESONANCE_ROUNDS = 2  # rounds of frequency-matched values for a resonant candidate in screening
+REFIT_ROUNDS = 3
+REFIT_STEP = 0.04  # first stencil step of the joint refit, in unit coordinates (4 % of each range)
+REFIT_REACH = 2.0  # the quadratic's minimum is looked for within 2 steps of the best point
 
 
 @dataclass
 class Point:
-    value: float
+    value: float  # the candidate's value; for a joint refit, a tuple: one value per effect
     fit: Fit | None  # None: the run failed
     prediction: Prediction
     error: str = ""
@@ -89,11 +102,39 @@ def score_point(record: Record, sensors: list[str], value: float, prediction: Pr
     return Point(value, fit, prediction)
 
 
-def screen(evaluator, record, sensors, candidates: list[Candidate], document) -> list[Scored]:
+def aligned_residuals(record: Record, prediction: Prediction, offset: float) -> dict[str, np.ndarray]:
+    """The record minus the prediction at trigger offset `offset`, both in the comparison band (D0)."""
+    return residuals(record, predict(record, prediction.time, {s: prediction.sensors[s] for s in record.values}, offset))
+
+
+def screen(evaluator, record, sensors, candidates: list[Candidate], document, baseline: Point) -> list[Scored]:
     scored = [Scored(c) for c in candidates]
     evaluate_points(evaluator, record, sensors, [(s, v) for s in scored for v in s.candidate.from_unit(SCREEN_POINTS)],
                     document)
+    resonant = [s for s in scored if s.candidate.resonant]
+    for _ in range(RESONANCE_ROUNDS if resonant else 0):
+        latest = {id(s): len(s.points) for s in resonant}
+        jobs = [(s, v) for s in resonant for v in resonance_seeds(record, baseline, s.points[-2:], s.candidate)]
+        evaluate_points(evaluator, record, sensors, jobs, document)
+        resonant = [s for s in resonant if len(s.points) > latest[id(s)]]
     return scored
+
+
+def resonance_seeds(record: Record, baseline: Point, points: list[Point], candidate: Candidate) -> list[float]:
+    """For each run, the value whose ringing would match the record's: k (f_record / f_run)², where f_record is the
+    peak of the residual of the model as given and f_run that of the run's change to the model (both in the
+    comparison band, at the model's trigger offset). New values only, within the bounds."""
+    base = aligned_residuals(record, baseline.prediction, baseline.fit.offset)
+    target = dominant_frequency(record, base)
+    seeds = []
+    for point in points:
+        if point.fit is None or target is None:
+            continue
+        change = aligned_residuals(record, point.prediction, baseline.fit.offset)
+        own = dominant_frequency(record, {s: base[s] - change[s] for s in base})
+        if own:
+            seeds.append(float(np.clip(point.value * (target / own) ** 2, candidate.low, candidate.high)))
+    return [v for v in dict.fromkeys(seeds) if v not in {p.value for p in points}]
 
 
 def seen_by_sensors(scored: Scored, baseline: float) -> bool:
@@ -213,12 +254,11 @@ def mark_ties(ranked: list[Scored], all_sensors_scale: dict[str, float]) -> None
                                                all_sensors_scale)
 
 
-def halves_improved(record: Record, sensors: list[str], baseline: Point, effect: Point) -> tuple[float, float]:
+def halves_improved(record: Record, baseline: Point, effect: Point) -> tuple[float, float]:
     """Δχ² of the effect over the model on each half of the record (both negative: the improvement
     is not carried by one part of the record alone — the split-record check of DESIGN.md §8)."""
     def halves(point: Point):
-        aligned = predict(record, point.prediction.time, {s: point.prediction.sensors[s] for s in sensors}, point.fit.offset)
-        return chi_square_halves(record, residuals(record, aligned))
+        return chi_square_halves(record, aligned_residuals(record, point.prediction, point.fit.offset))
 
     (base_first, base_second), (first, second) = halves(baseline), halves(effect)
     return first - base_first, second - base_second
@@ -238,3 +278,99 @@ def telling_sensor(first: Prediction, others: list[Prediction], scale: dict[str,
             if score > best_score:
                 best_name, best_score = name, score
     return best_name
+
+
+# --- joint refit of the effects found -------------------------------------------------------------
+
+
+@dataclass
+class JointFit:
+    """All effects found refitted together; each point's value is the tuple of their values."""
+
+    candidates: list[Candidate]
+    start: tuple[float, ...]  # the values found one after another (greedy)
+    points: list[Point] = field(default_factory=list)
+    step: float = REFIT_STEP  # the last stencil step, in unit coordinates
+
+    @property
+    def best(self) -> Point:
+        return min((p for p in self.points if p.fit is not None), key=lambda p: p.chi_square)
+
+    @property
+    def start_point(self) -> Point:
+        return next(p for p in self.points if p.value == self.start)
+
+    def units(self, values) -> np.ndarray:
+        return np.array([float(c.to_unit(v)) for c, v in zip(self.candidates, values)])
+
+    def values(self, units) -> tuple[float, ...]:
+        return tuple(float(c.from_unit(u)) for c, u in zip(self.candidates, units))
+
+    def intervals(self, allowance: float) -> list[tuple[float, float]]:
+        """Per effect: the span of the evaluated points whose χ² is within `allowance` of the best, widened
+        by half the last step on each side (in unit coordinates, kept within the bounds)."""
+        best = self.best.chi_square
+        inside = np.array([self.units(p.value) for p in self.points if p.fit is not None and p.chi_square <= best + allowance])
+        low = np.clip(inside.min(axis=0) - 0.5 * self.step, 0.0, 1.0)
+        high = np.clip(inside.max(axis=0) + 0.5 * self.step, 0.0, 1.0)
+        return list(zip(self.values(low), self.values(high)))
+
+
+def refit_jointly(evaluator: Evaluator, record: Record, sensors: list[str], document: dict,
+                  candidates: list[Candidate], start, rounds: int = REFIT_ROUNDS) -> JointFit:
+    """Refit the effects' values together, starting from the greedy ones: each round runs a stencil of
+    axial and pairwise-diagonal neighbours of the best point (one parallel batch), then the minimum of a
+    quadratic surface fitted to the points near it (if convex), and halves the step."""
+    joint = JointFit(list(candidates), tuple(float(v) for v in start))
+    _run_joint(evaluator, record, sensors, document, joint, [joint.units(joint.start)])
+    step = REFIT_STEP
+    for _ in range(rounds):
+        centre = joint.units(joint.best.value)
+        _run_joint(evaluator, record, sensors, document, joint, stencil(centre, step))
+        vertex = quadratic_minimum(joint, centre, step)
+        if vertex is not None:
+            _run_joint(evaluator, record, sensors, document, joint, [vertex])
+        joint.step = step
+        step /= 2.0
+    return joint
+
+
+def _run_joint(evaluator, record, sensors, document, joint: JointFit, units: list) -> None:
+    known = {p.value for p in joint.points}
+    new = [v for v in dict.fromkeys(joint.values(u) for u in units) if v not in known]
+    predictions = evaluator.evaluate([with_effects(document, joint.candidates, v) for v in new])
+    joint.points += [score_point(record, sensors, v, p) for v, p in zip(new, predictions)]
+
+
+def stencil(centre: np.ndarray, step: float) -> list[np.ndarray]:
+    """±step along each axis and (±step, ±step) in each pair of axes around `centre`, kept in [0, 1]."""
+    axes = np.eye(len(centre))
+    moves = [sign * axes[i] for i in range(len(centre)) for sign in (-1.0, 1.0)]
+    moves += [a * axes[i] + b * axes[j] for i in range(len(centre)) for j in range(i + 1, len(centre))
+              for a in (-1.0, 1.0) for b in (-1.0, 1.0)]
+    return [np.clip(centre + step * move, 0.0, 1.0) for move in moves]
+
+
+def quadratic_minimum(joint: JointFit, centre: np.ndarray, step: float) -> np.ndarray | None:
+    """Minimum of a quadratic surface fitted (least squares) to χ² over the points within REFIT_REACH steps
+    of `centre`, kept within that reach and the bounds; None when too few points or the surface is not convex."""
+    finished = [p for p in joint.points if p.fit is not None]
+    x = np.array([(joint.units(p.value) - centre) / step for p in finished])
+    near = np.max(np.abs(x), axis=1) <= REFIT_REACH * (1.0 + 1e-9)
+    n = len(centre)
+    pairs = [(i, j) for i in range(n) for j in range(i, n)]
+    if near.sum() < 2 + n + len(pairs):
+        return None
+    x = x[near]
+    design = np.column_stack([np.ones(len(x)), x, *[x[:, i] * x[:, j] for i, j in pairs]])
+    coefficients = np.linalg.lstsq(design, np.array([p.chi_square for p, keep in zip(finished, near) if keep]),
+                                   rcond=None)[0]
+    gradient = coefficients[1:n + 1]
+    hessian = np.zeros((n, n))
+    for (i, j), c in zip(pairs, coefficients[n + 1:]):
+        hessian[i, j] += c
+        hessian[j, i] += c
+    if np.any(np.linalg.eigvalsh(hessian) <= 0.0):
+        return None
+    offset = np.clip(np.linalg.solve(hessian, -gradient), -REFIT_REACH, REFIT_REACH)
+    return np.clip(centre + step * offset, 0.0, 1.0)

@@ -4,7 +4,9 @@
 
 Greedy forward selection: each iteration fits every candidate effect to the record on top of the
 model as it stands (the original plus the effects found so far), keeps the best one if its BIC
-beats the model's by SIGNIFICANCE, and stops when none does or `max_effects` are found.
+beats the model's by SIGNIFICANCE, and stops when none does or `max_effects` are found. Several
+effects found are then refitted together (search.refit_jointly); their reported values, intervals
+and gaps are the joint ones, their evidence (ΔBIC, ties, halves) the greedy step's that found them.
 """
 
 from __future__ import annotations
@@ -18,11 +20,12 @@ import numpy as np
 import yaml
 
 from clearsim.diagnose.align import Fit, Record, predict, prepare_record, residuals
-from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for
+from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for, with_effects
 from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
 from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
-from clearsim.diagnose.search import SIGNIFICANCE, Scored, halves_improved, judge, to_fit, mark_ties, refine, score_point, screen, seen_by_sensors
+from clearsim.diagnose.search import (SIGNIFICANCE, JointFit, Point, Scored, halves_improved, judge, mark_ties, refine,
+                                     refit_jointly, score_point, screen, seen_by_sensors, to_fit)
 from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.model.loader import load_mechanism, load_mechanism_text
 from clearsim.units import UnitError, to_si
@@ -62,6 +65,27 @@ class Iteration:
 
 
 @dataclass
+class Effect:
+    """An effect as reported: the greedy iteration that found it (its evidence: ΔBIC, ties, halves), and
+    its value, interval and fit — after the joint refit when several effects were found."""
+
+    scored: Scored
+    value: float
+    interval: tuple[float, float]
+    point: Point  # the model with this effect and those found before it
+    before: Fit  # the model with the effects found before it
+
+    @property
+    def candidate(self) -> Candidate:
+        return self.scored.candidate
+
+
+def found_effect(scored: Scored, before: Fit) -> Effect:
+    """The effect as the greedy iteration fitted it."""
+    return Effect(scored, scored.estimate.value, scored.interval, scored.estimate, before)
+
+
+@dataclass
 class Diagnosis:
     request: DiagnoseRequest
     folder: Path
@@ -71,13 +95,11 @@ class Diagnosis:
     original: dict  # the document as given (with --set)
     final: dict  # with the effects found
     iterations: list[Iteration]
+    effects: list[Effect]  # in the order found; values after the joint refit
+    joint: JointFit | None  # the joint refit (two effects or more)
     simulations: int
     wall_time: float
     units: dict
-
-    @property
-    def effects(self) -> list[Scored]:
-        return [it.found for it in self.iterations if it.found is not None]
 
     @property
     def before(self) -> Fit:
@@ -85,13 +107,11 @@ class Diagnosis:
 
     @property
     def after(self) -> Fit:
-        found = self.effects
-        return found[-1].estimate.fit if found else self.before
+        return self.effects[-1].point.fit if self.effects else self.before
 
     @property
     def after_prediction(self) -> Prediction:
-        found = self.effects
-        return found[-1].estimate.prediction if found else self.iterations[0].baseline_prediction
+        return self.effects[-1].point.prediction if self.effects else self.iterations[0].baseline_prediction
 
 
 def chosen_kinds(text: str | None) -> list[str]:
@@ -153,6 +173,7 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
     executor = _executor(request)
     evaluator = Evaluator(folder / "runs", str(request.config), Path(request.config).parent, executor, record.rate)
     iterations: list[Iteration] = []
+    joint = None
     try:
         found_keys: set = set()
         for number in range(1, request.max_effects + 1):
@@ -162,10 +183,42 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
                 break
             found_keys.add(iteration.found.candidate.key)
             document = iteration.found.candidate.applied(document, iteration.found.estimate.value)
+        effects = [found_effect(it.found, it.baseline) for it in iterations if it.found is not None]
+        if len(effects) >= 2:
+            joint = refit_jointly(evaluator, record, sensors, original, [e.candidate for e in effects],
+                                  [e.value for e in effects])
+            effects = refitted(evaluator, record, sensors, original, effects, joint)
+            document = with_effects(original, [e.candidate for e in effects], [e.value for e in effects])
+            say(f"  {refit_line(joint, effects)}")
     finally:
         executor.close()
-    return Diagnosis(request, folder, measured, record, sensors, original, document, iterations,
+    return Diagnosis(request, folder, measured, record, sensors, original, document, iterations, effects, joint,
                      evaluator.simulations, clock.perf_counter() - started, units)
+
+
+def refitted(evaluator, record: Record, sensors: list[str], document: dict, effects: list[Effect],
+             joint: JointFit) -> list[Effect]:
+    """The effects at the jointly refitted values: each with the fit of the model with it and the effects
+    before it (one parallel batch for those nested models), and its interval from the joint refit."""
+    values = joint.best.value
+    candidates = [e.candidate for e in effects]
+    nested = evaluator.evaluate([with_effects(document, candidates[:k], values[:k]) for k in range(1, len(effects))])
+    points = [score_point(record, sensors, values[:k], p) for k, p in enumerate(nested, start=1)] + [joint.best]
+    failed = next((p for p in points if p.fit is None), None)
+    if failed is not None:
+        raise DiagnoseError(f"the model with the refitted effects {failed.value} does not run: {failed.error}")
+    allowance = max(1.0, joint.best.chi_square / max(record.effective_samples, 1.0))
+    befores = [effects[0].before] + [p.fit for p in points[:-1]]
+    return [Effect(e.scored, v, i, p, b)
+            for e, v, i, p, b in zip(effects, values, joint.intervals(allowance), points, befores)]
+
+
+def refit_line(joint: JointFit, effects: list[Effect]) -> str:
+    """'refitted together (27 runs): drive of hydraulic_drive (lag) 1.71 ms → 1.98 ms, …; gap 3.75 → 1.1'."""
+    changes = ", ".join(f"{e.candidate.label} {e.candidate.shown(v0)} → {e.candidate.shown(e.value)}"
+                        for e, v0 in zip(effects, joint.start))
+    return (f"refitted together ({len(joint.points)} runs): {changes}; "
+            f"gap {joint.start_point.fit.gap:.3g} → {joint.best.fit.gap:.3g}")
 
 
 def _record_line(record: Record) -> str:
@@ -183,14 +236,15 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     if not base_prediction.ok:
         raise DiagnoseError(f"{request.config}: the model does not run to the end ({base_prediction.error}); "
                             "fix it with `clearsim run` first")
-    baseline = score_point(record, sensors, 0.0, base_prediction).fit
+    base_point = score_point(record, sensors, 0.0, base_prediction)
+    baseline = base_point.fit
     aligned = predict(record, base_prediction.time, {s: base_prediction.sensors[s] for s in sensors}, baseline.offset)
     found_features = features(record, aligned, units)
     windows = disagreement_windows(record, residuals(record, aligned))
     say(f"iteration {number}: gap {baseline.gap:.3g} (trigger offset {baseline.offset * 1e3:.3f} ms), "
         f"{len(windows)} window(s) outside the noise band")
-    candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds) if c.key not in found_keys]
-    scored = screen(evaluator, record, sensors, candidates, document)
+    candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds, Path(request.config).parent) if c.key not in found_keys]
+    scored = screen(evaluator, record, sensors, candidates, document, base_point)
     visible = [s for s in scored if seen_by_sensors(s, baseline.chi_square)]
     chosen = to_fit(visible, baseline, record, request.fit_top)
     say(f"  screened {len(candidates)} candidates ({len(visible)} visible to the sensors); fitting "
@@ -200,22 +254,22 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
     if winner is not None:
         mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
-        winner.halves = halves_improved(record, sensors, score_point(record, sensors, 0.0, base_prediction), winner.estimate)
-        say(f"  found: {effect_line(winner, baseline)}")
+        winner.halves = halves_improved(record, base_point, winner.estimate)
+        say(f"  found: {effect_line(found_effect(winner, baseline))}")
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
 
 
-def effect_line(scored: Scored, baseline: Fit) -> str:
+def effect_line(effect: Effect) -> str:
     """'clearance in joint B, clearance = 0.082 mm (0.071–0.094 mm); gap 14.2 → 1.3 (−91%)'."""
-    c: Candidate = scored.candidate
-    best = scored.estimate
-    low, high = scored.interval
-    change = (best.fit.gap - baseline.gap) / baseline.gap if baseline.gap > 0 else 0.0
+    c, scored = effect.candidate, effect.scored
+    low, high = effect.interval
+    before, after = effect.before.gap, effect.point.fit.gap
+    change = (after - before) / before if before > 0 else 0.0
     tie = f"; fits as well: {', '.join(scored.ambiguous_with)}" if scored.ambiguous_with else ""
     tell = f" (tell apart with sensor {scored.telling_sensor})" if scored.telling_sensor else ""
     if scored.halves is not None and max(scored.halves) >= 0.0:
         tell += "; not confirmed: it does not improve both halves of the record"
-    return (f"{c.label}, {c.parameter} = {c.shown(best.value)} ({c.shown(low)}–{c.shown(high)}); "
-            f"gap {baseline.gap:.3g} → {best.fit.gap:.3g} ({change:+.0%}){tie}{tell}")
+    return (f"{c.label}, {c.parameter} = {c.shown(effect.value)} ({c.shown(low)}–{c.shown(high)}); "
+            f"gap {before:.3g} → {after:.3g} ({change:+.0%}){tie}{tell}")

@@ -18,6 +18,12 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import yaml
+
+from clearsim.diagnose.candidates import candidates_for
+from clearsim.diagnose.evaluate import document_text
+from clearsim.model.loader import load_mechanism
+
 CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
 UHV, SLIDER_CRANK = CONFIGS / "uhv_breaker.yaml", CONFIGS / "slider_crank_flores.yaml"
 FRICTION_CRANK = CONFIGS / "slider_crank_flores_friction.yaml"
@@ -41,6 +47,7 @@ class Study:
     noise: str
     options: list[str]
     seed: int = 3
+    hidden_candidate: tuple[str, str, float] | None = None  # (kind, target, value): an effect --set cannot write
 
 
 STUDIES = [
@@ -60,6 +67,11 @@ STUDIES = [
           "clearance slider_pin 0.2 mm", CRANK_BENCH, "0.5%", ["--candidates", "clearance,drive,mass"]),
     Study("crank-friction", FRICTION_CRANK, [], ["joints.slider_pin.friction.mu_d=0.1"], "friction slider_pin μ_d 0.1",
           CRANK_BENCH, "0.1%", ["--candidates", "friction,restitution,clearance"], seed=5),
+    Study("crank-compliance", SLIDER_CRANK, ["joints.slider_pin.clearance=0"], [], "rod axial stiffness 15 MN/m",
+          CRANK_BENCH, "0.5%", ["--candidates", "compliance,clearance"], hidden_candidate=("compliance", "rod", 15e6)),
+    Study("uhv-pole-compliance", UHV, FRICTIONLESS_UHV, [], "insulating pole axial stiffness 30 MN/m (contact sensors)",
+          ["--sensors", "contact_displacement,contact_velocity", *UHV_BENCH[2:]], "0.05%", ["--candidates", "compliance,clearance,drive"], seed=7,
+          hidden_candidate=("compliance", "insulating_pole", 30e6)),
 ]
 
 
@@ -75,7 +87,9 @@ def run_study(study: Study, root: Path) -> dict:
     folder.mkdir(parents=True, exist_ok=True)
     record = folder / "bench.csv"
     if not record.exists():
-        subprocess.run(["clearsim", "synthesize", str(study.config), *sets(study.model + study.hidden), *study.bench,
+        source = truth_model(study, folder)
+        hidden = sets(study.model + study.hidden) if source == study.config else []
+        subprocess.run(["clearsim", "synthesize", str(source), *hidden, *study.bench,
                         "--noise", study.noise, "--seed", str(study.seed), "-o", str(record)], check=True,
                        capture_output=True)
     report = folder / "report"
@@ -89,13 +103,28 @@ def run_study(study: Study, root: Path) -> dict:
     return found
 
 
+def truth_model(study: Study, folder: Path) -> Path:
+    """The file the record is synthesized from: the study's config, or for a hidden candidate (an effect that
+    --set cannot write, e.g. a compliance) that candidate written into the model, as `truth.yaml`."""
+    if study.hidden_candidate is None:
+        return study.config
+    kind, target, value = study.hidden_candidate
+    loaded = load_mechanism(study.config, study.model + study.hidden)
+    document = yaml.safe_load(loaded.resolved_yaml)
+    candidate = next(c for c in candidates_for(loaded.mechanism, document, [kind]) if c.target == target)
+    path = folder / "truth.yaml"
+    path.write_text(document_text(candidate.applied(document, value)), encoding="utf-8")
+    return path
+
+
 def describe(found: dict) -> str:
     if not found["effects"]:
         return "no missing effect found"
     parts = []
     for effect in found["effects"]:
         (name, value), = effect["parameters"].items()
-        shown = f"{value * 1e3:.4g} mm" if name == "clearance" else f"{value * 1e3:.3g} ms" if name == "lag" else f"{value:.3g}"
+        shown = (f"{value * 1e3:.4g} mm" if name == "clearance" else f"{value * 1e3:.3g} ms" if name == "lag"
+                 else f"{value / 1e6:.3g} MN/m" if effect["kind"] == "compliance" else f"{value:.3g}")
         tie = f" (tie: {', '.join(effect['ambiguous_with'])})" if effect["ambiguous_with"] else ""
         parts.append(f"{effect['kind']} {effect['target']} {name} = {shown}{tie}")
     return "; ".join(parts)

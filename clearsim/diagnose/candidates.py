@@ -379,10 +379,9 @@ def initial_tension(document: dict, split: LinkSplit, base_dir: Path) -> float:
         system = assemble(load_mechanism_text(document_text(locked), "compliance", (), base_dir).mechanism, base_dir)
     except (BuildError, ClearsimError, ValueError):
         return 0.0
-    contacts = len(system.clearance_joints)
-    forces = generalized_forces(system.arrays, 0.0, system.q0, system.qd0, np.zeros(contacts, np.int64),
-                                np.zeros(contacts))[0]
-    multipliers = accelerations(system.arrays, 0.0, system.q0, system.qd0, forces)[1]
+    free = np.zeros(len(system.clearance_joints), np.int64)  # every journal starts in free flight (mode FREE)
+    forces = generalized_forces(system.arrays, 0.0, system.q0, system.qd0, free, np.zeros(free.size))[0]
+    multipliers = accelerations(system.arrays, 0.0, system.q0, system.qd0, forces, free)[1]
     return float(multipliers[dict(system.drivers)[lock]])
 
 

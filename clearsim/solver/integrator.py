@@ -329,7 +329,7 @@ def normal_force_at(system, k, y, stages, h, theta, modes, speeds, scratch):
 def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
     """Raise peak_force[k] to the largest F_n of the step: at 4 points, then at an interior maximum.
 
-    A peak between the sampled points that could raise the peak so far is refined by golden-section
+    A maximum near the sampled one that could raise the peak so far is refined by golden-section
     search on the continuous extension (to 1e-5 of the step), so the peak contact force does not
     depend on where the steps happen to end.
     """
@@ -342,9 +342,8 @@ def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
             force = normal_force_at(system, k, y, stages, h, i / SUBDIVISIONS, modes, speeds, scratch)
             if force > best:
                 best, best_theta = force, i / SUBDIVISIONS
-        if best_theta == 0.0 or best_theta == 1.0 or best < PEAK_CANDIDATE * peak_force[k]:
-            peak_force[k] = max(peak_force[k], best)
-            continue  # the step's force peaks at an end, or far below the peak so far: nothing to refine
+        if best < PEAK_CANDIDATE * peak_force[k]:
+            continue  # far below the peak so far: nothing to refine
         lo = max(best_theta - 1.0 / SUBDIVISIONS, 0.0)
         hi = min(best_theta + 1.0 / SUBDIVISIONS, 1.0)
         a, b = hi - golden * (hi - lo), lo + golden * (hi - lo)

@@ -215,7 +215,7 @@ def _matched(rows: list[dict], target: float) -> dict | None:
 def at_peer_accuracy(row: dict, ladder: list[dict]) -> dict:
     """An Exudyn row with the loosest clearsim rtol at least as accurate in both errors, and the wall ratio."""
     keys = ("error_peak_acceleration", "error_max_contact_force")
-    mine = next((r for r in ladder if all(r[k] <= row[k] for k in keys)), None)
+    mine = next((r for r in ladder if "failed" not in r and all(r[k] <= row[k] for k in keys)), None)
     return {**row, "clearsim": mine, "ratio": row["wall_s"] / mine["wall_s"] if mine else None}
 
 

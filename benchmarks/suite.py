@@ -200,7 +200,11 @@ def clearsim_ladder(case_name: str, repeats: int, folder: Path) -> list[dict]:
     rows = []
     for rtol in CLEARSIM_LADDER:
         settings = case.overrides + (f"solver.rtol={rtol!r}", f"solver.atol={rtol / 1000.0!r}")
-        runs = [_run(case.config, settings, folder, f"{case_name}-ladder-{rtol:g}-{k}") for k in range(repeats)]
+        try:
+            runs = [_run(case.config, settings, folder, f"{case_name}-ladder-{rtol:g}-{k}") for k in range(repeats)]
+        except RuntimeError as failure:  # a tolerance too loose for the contact: the row says so
+            rows.append({"rtol": rtol, "failed": str(failure)})
+            continue
         peak, force = _figures(runs[-1][2])
         rows.append({"rtol": rtol, "wall_s": statistics.median(r[0] for r in runs),
                      "error_peak_acceleration": _relative(peak, ref_peak),

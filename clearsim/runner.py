@@ -176,7 +176,7 @@ def summarize(path: Path) -> Summary:
 
 
 def _peak_contact_force(path: Path, joint: str, sampled: np.ndarray) -> float:
-    """The larger of the sampled peak and the peak over all step ends (which samples can miss)."""
+    """The larger of the sampled peak and the peak located within every step (which samples can miss)."""
     tracked = group_attribute(path, f"joints/{joint}/episodes", "peak_normal_force_N", 0.0)
     return max(float(tracked), float(np.max(sampled, initial=0.0)))
 

@@ -177,7 +177,8 @@ class Run:
             ig.DRIFT: ("the constraints could not be satisfied any more (assembly lost)",
                        "the mechanism reaches a toggle or singular position here: check the geometry and the drive stroke"),
             ig.TOO_DEEP: ("the penetration exceeded 5 % of the journal radius, far outside any contact law's range",
-                          "the contact stiffness is far too low for the load: check `stiffness` and its unit (N/m^1.5)"),
+                          "the contact stiffness is far too low for the load (check `stiffness` and its unit, N/m^1.5), "
+                          "or solver.rtol too loose to resolve the impact (try 1e-7)"),
         }
         message, hint = messages[status]
         return SolverError(message, time=t, element=joint, hint=hint)

@@ -19,7 +19,7 @@ CONFIG = Path(__file__).resolve().parents[2] / "clearsim" / "configs" / "slider_
 
 
 def study(config: Path, tolerances=(1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11)) -> None:
-    print("| rtol | steps | peak F_n (N, samples) | peak F_n (N, step ends) | output-acceleration RMS (m/s²) "
+    print("| rtol | steps | peak F_n (N, samples) | peak F_n (N, located) | output-acceleration RMS (m/s²) "
           "| contact episodes | first onset (ms) |")
     print("|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as folder:

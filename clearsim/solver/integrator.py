@@ -39,10 +39,11 @@ from clearsim.solver.dopri import STAGES, error_norm, interpolate, step
 R_TIME, R_STEP, R_T_END, R_RTOL, R_ATOL, R_MAX_STEP, R_MIN_STEP, R_SAMPLE_DT, R_VIOLATION = range(9)
 # int_state slots
 (I_STATUS, I_STEPS, I_REJECTED, I_RHS, I_EVENTS, I_SAMPLES, I_NEXT_SAMPLE, I_FAIL_JOINT, I_LOG, I_TOTAL_SAMPLES,
- I_FRICTION_EVENTS) = range(11)
-INT_SLOTS = 11
+ I_FRICTION_EVENTS, I_STALLED) = range(12)
+INT_SLOTS = 12
 
-RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END = range(8)
+RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END, CHATTER = range(9)
+STALLED_STEPS = 2000  # consecutive accepted steps shorter than min_step: the events no longer advance the time
 
 SUBDIVISIONS = 4  # points per step at which the event functions are sampled
 PROJECTION_TOLERANCE = 1e-13  # m (rad): max |Φ| kept after each step
@@ -233,12 +234,14 @@ def contact_time_step(system, k, q, speed):
 
 
 @njit(cache=True)
-def settle_friction(system, k, t, y, modes, speeds):
+def settle_friction(system, k, t, y, modes, speeds, may_stick=True):
     """Choose how joint k's contact carries friction at time t: slide on, or stick if the wall can hold it.
 
     Sliding faster than DECIDE_SPEED goes on in its direction. Slower (a reversal, or a new contact
     that barely slides), the joint sticks when the friction force its stick constraint needs is within
-    μ_s F_n, and otherwise slides against that force. Sticking starts with v_t projected to 0.
+    μ_s F_n, and otherwise slides against that force. Sticking starts with v_t projected to 0. A joint
+    whose stick just broke (may_stick False) slides even if the state reached sits a hair before the
+    crossing, so that the switch always happens and the time moves on.
     """
     if not exact_stick(system, k):
         modes[k] = CONTACT
@@ -250,7 +253,7 @@ def settle_friction(system, k, t, y, modes, speeds):
         return
     modes[k] = STICK
     reserve, friction = friction_reserve(system, t, y, modes, speeds, k)
-    if reserve < 0.0:
+    if reserve < 0.0 or not may_stick:
         modes[k] = SLIDE_BACK if friction > 0.0 else CONTACT
     else:
         project_state(system, t, y, modes)
@@ -262,7 +265,7 @@ def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_join
     """Apply joint k's event at time t; returns the suggested next step."""
     n = coordinate_count(system)
     if kind == TANGENTIAL:
-        settle_friction(system, k, t, y, modes, speeds)
+        settle_friction(system, k, t, y, modes, speeds, modes[k] != STICK)
         ints[I_FRICTION_EVENTS] += 1
         return np.inf
     if modes[k] != FREE:
@@ -457,6 +460,11 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
         y[:] = y_new
         real[R_TIME] = t + h if h < real[R_T_END] - t else real[R_T_END]
         ints[I_STEPS] += 1
+        ints[I_STALLED] = ints[I_STALLED] + 1 if h < real[R_MIN_STEP] else 0
+        if ints[I_STALLED] > STALLED_STEPS:
+            ints[I_STATUS] = CHATTER
+            ints[I_FAIL_JOINT] = event_joint
+            return
         if not np.all(np.isfinite(y)):
             ints[I_STATUS] = NOT_FINITE
             return

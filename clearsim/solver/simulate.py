@@ -176,6 +176,10 @@ class Run:
                             "check masses, inertias, stiffness and force units for values off by orders of magnitude"),
             ig.DRIFT: ("the constraints could not be satisfied any more (assembly lost)",
                        "the mechanism reaches a toggle or singular position here: check the geometry and the drive stroke"),
+            ig.CHATTER: (f"the contact events stopped advancing the time ({ig.STALLED_STEPS} steps in a row shorter than "
+                         "solver.min_step)",
+                         "the friction of this joint switches between sticking and sliding without end: try "
+                         "`friction: {stick: smooth}` on it, or another solver.rtol"),
             ig.TOO_DEEP: ("the penetration exceeded 5 % of the journal radius, far outside any contact law's range",
                           "the contact stiffness is far too low for the load (check `stiffness` and its unit, N/m^1.5), "
                           "or solver.rtol too loose to resolve the impact (try 1e-7)"),
@@ -190,7 +194,7 @@ class Run:
             phi = np.zeros(m)
             evaluate_constraints(system.arrays, self.time, self.y[: self.coordinate_count], phi)
             return system.row_owners[int(np.argmax(np.abs(phi)))] if m else None
-        if status == ig.TOO_DEEP:
+        if status in (ig.TOO_DEEP, ig.CHATTER) and self.ints[ig.I_FAIL_JOINT] >= 0:
             return system.clearance_joints[int(self.ints[ig.I_FAIL_JOINT])]
         in_contact = [k for k, mode in enumerate(self.modes) if mode != FREE]
         if in_contact:

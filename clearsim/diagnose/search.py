@@ -18,7 +18,7 @@ affordable grid step) is not zoomed: after the scan, two rounds of evenly spread
 about the smoothed minimum (a least-squares parabola through every run in the window), the window
 halved each round, then one run at the last parabola's vertex. That run is the estimate (not the
 lowest run, which is whichever tooth the grid happened to hit), its interval the vertex ± its
-standard error.
+uncertainty (standard error and the width the comb's scatter leaves).
 
 After greedy selection has found several effects, `refit_jointly` refits all their values together
 (each was fitted with the earlier ones held at their own single-effect fits, which biases them):
@@ -209,19 +209,23 @@ def _window_values(scored: Scored) -> list[float]:
 
 def _smoothed_minimum(scored: Scored, centre: float, half: float) -> tuple[float, float]:
     """Minimum of the profile smoothed over [centre − half, centre + half] (unit range): the vertex of a
-    least-squares parabola through every run in it, and the vertex's standard error (delta method; the comb's
-    scatter about the parabola taken as the noise). When the parabola is not convex or its vertex leaves the
-    window: the lowest run in the window, with the window's half-width as the error."""
+    least-squares parabola a (u − v)² + c through every run in it, and its uncertainty √(σ_v² + s/a): σ_v the
+    vertex's standard error (delta method, the comb's scatter about the parabola taken as the noise), √(s/a)
+    the half-width where the parabola rises by s, the RMS of that scatter (values the comb does not tell
+    apart). When the parabola is not convex or its vertex leaves the window: the lowest run in the window,
+    with the window's half-width as the uncertainty."""
     points = [p for p in scored.points if p.fit is not None]
     units = scored.candidate.to_unit([p.value for p in points])
     chi = np.array([p.chi_square for p in points])
     inside = np.abs(units - centre) <= half * (1.0 + 1e-9)
     if inside.sum() >= 6:  # polyfit's covariance needs more points than coefficients + 2
-        (a, b, _), covariance = np.polyfit(units[inside] - centre, chi[inside], 2, cov=True)
+        coefficients, covariance = np.polyfit(units[inside] - centre, chi[inside], 2, cov=True)
+        a, b, _ = coefficients
         vertex = -b / (2.0 * a) if a > 0.0 else np.inf
         if abs(vertex) <= half:
             gradient = np.array([b / (2.0 * a * a), -1.0 / (2.0 * a), 0.0])
-            error = float(np.sqrt(max(gradient @ covariance @ gradient, 0.0)))
+            scatter = np.sqrt(np.mean((chi[inside] - np.polyval(coefficients, units[inside] - centre)) ** 2))
+            error = float(np.sqrt(max(gradient @ covariance @ gradient, 0.0) + scatter / a))
             return float(np.clip(centre + vertex, 0.0, 1.0)), error
     lowest = np.flatnonzero(inside)[np.argmin(chi[inside])] if inside.any() else int(np.argmin(chi))
     return float(units[lowest]), half
@@ -299,7 +303,7 @@ def interval(scored: Scored, record: Record) -> tuple[float, float]:
 
 
 def smoothed_interval(scored: Scored) -> tuple[float, float]:
-    """A rough candidate's interval: the smoothed profile's vertex ± its standard error, within the bounds."""
+    """A rough candidate's interval: the smoothed profile's vertex ± its uncertainty, within the bounds."""
     vertex, error = scored.smoothed
     low, high = np.clip([vertex - error, vertex + error], 0.0, 1.0)
     return float(scored.candidate.from_unit(low)), float(scored.candidate.from_unit(high))

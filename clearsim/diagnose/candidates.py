@@ -43,6 +43,7 @@ class Candidate:
     write: Callable[[dict, float], None]  # puts a value into a document
     display_unit: tuple[str, float] = ("", 1.0)  # unit shown to engineers and the SI value of one of it
     resonant: bool = False  # the parameter is a stiffness setting a resonance, frequency ∝ √value (search.resonance_seeds)
+    rough: bool = False  # its cost is a comb of narrow minima: fitted on the smoothed profile (search.rough_rounds)
 
     @property
     def key(self) -> tuple[str, str | None, str]:
@@ -139,7 +140,9 @@ FRICTION_BOUNDS = (0.0, 0.5)
 
 
 def friction(mechanism, document) -> list[Candidate]:
-    """Dynamic friction coefficient μ_d of each clearance joint (μ_s keeps its ratio to μ_d)."""
+    """Dynamic friction coefficient μ_d of each clearance joint (μ_s keeps its ratio to μ_d). Rough: friction
+    reaches kinematic sensors through the chaotic journal motion, so χ² over μ_d is a comb of narrow minima
+    (slider-crank: teeth ~0.004 wide in μ_d) over a smooth basin."""
     out = []
     for joint in _clearance_joints(mechanism):
         p = resolve_clearance(joint, mechanism.defaults)
@@ -153,7 +156,7 @@ def friction(mechanism, document) -> list[Candidate]:
             _set(doc, f"joints.{name}.friction", f"{{law: {law}, {body}}}")
 
         current = p.mu_d if p.friction_law != "none" else None
-        out.append(Candidate("friction", joint.name, "mu_d", "", *FRICTION_BOUNDS, False, current, write))
+        out.append(Candidate("friction", joint.name, "mu_d", "", *FRICTION_BOUNDS, False, current, write, rough=True))
     return out
 
 

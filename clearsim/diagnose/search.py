@@ -13,6 +13,13 @@ around its best point, never a gradient method:
     vertex   one value at the vertex of a parabola through the profile near its best point (the
              minimum with the chaotic scatter of single runs smoothed out)
 
+A rough candidate (friction: its cost is a comb of narrow minima, the teeth far narrower than any
+affordable grid step) is not zoomed: after the scan, two rounds of evenly spread values in a window
+about the smoothed minimum (a least-squares parabola through every run in the window), the window
+halved each round, then one run at the last parabola's vertex. That run is the estimate (not the
+lowest run, which is whichever tooth the grid happened to hit), its interval the vertex ± its
+uncertainty (standard error and the width the comb's scatter leaves).
+
 After greedy selection has found several effects, `refit_jointly` refits all their values together
 (each was fitted with the earlier ones held at their own single-effect fits, which biases them):
 a stencil around the best values in the candidates' unit coordinates, a quadratic surface through it
@@ -43,6 +50,8 @@ TIE = 6.0  # BIC within 6 of the best: the data do not tell the two apart
 PROFILE_POINTS = 7  # points of the local parabola through the profile
 VISIBLE = 1.0  # |Δχ²| below 1 at both screening values: the sensors do not see the candidate
 RESONANCE_ROUNDS = 2  # rounds of frequency-matched values for a resonant candidate in screening
+ROUGH_ROUNDS = 2  # rounds of a rough candidate's window about its smoothed minimum
+ROUGH_POINTS = 8  # new values per round, evenly spread inside the window
 REFIT_ROUNDS = 3
 REFIT_STEP = 0.04  # first stencil step of the joint refit, in unit coordinates (4 % of each range)
 REFIT_REACH = 2.0  # the quadratic's minimum is looked for within 2 steps of the best point
@@ -73,6 +82,8 @@ class Scored:
     ambiguous_with: list[str] = field(default_factory=list)
     telling_sensor: str | None = None
     halves: tuple[float, float] | None = None  # Δχ² on the first and second half of the record
+    window: tuple[float, float] | None = None  # rough candidate: centre and half-width (unit range) of its window
+    smoothed: tuple[float, float] | None = None  # rough candidate: vertex of the smoothed profile and its std. error
 
     @property
     def best(self) -> Point | None:
@@ -81,7 +92,13 @@ class Scored:
 
     @property
     def estimate(self) -> Point | None:
-        """The point reported and added: the lowest χ² of all runs (grid, zooms, the profile's vertex)."""
+        """The point reported and added: the lowest χ² of all runs (grid, zooms, the profile's vertex); for a
+        rough candidate, the run at the smoothed profile's vertex."""
+        if self.smoothed is not None:
+            value = float(self.candidate.from_unit(self.smoothed[0]))
+            at_vertex = [p for p in self.points if p.fit is not None and p.value == value]
+            if at_vertex:
+                return at_vertex[0]
         return self.best
 
     allowance: float = 1.0  # Δχ² of the profile interval, set by `judge`
@@ -161,14 +178,57 @@ def to_fit(screened: list[Scored], baseline: Fit, record: Record, count: int) ->
 
 
 def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
-    """Scan, then zoom twice around each candidate's best point (each round one parallel batch)."""
+    """Scan, then zoom twice around each candidate's best point, or for a rough one two rounds about its
+    smoothed minimum (each round one parallel batch for all candidates)."""
     evaluate_points(evaluator, record, sensors, [(s, v) for s in chosen for v in s.candidate.grid(SCAN_POINTS)], document)
-    for count in ZOOM_ROUNDS:
-        evaluate_points(evaluator, record, sensors, [(s, v) for s in chosen for v in _zoom(s, count)], document)
-    evaluate_points(evaluator, record, sensors, [(s, v) for s in chosen if (v := profile_vertex(s)) is not None],
-                    document)
+    smooth = [s for s in chosen if not s.candidate.rough]
+    rough = [s for s in chosen if s.candidate.rough]
+    for s in rough:
+        s.window = (float(s.candidate.to_unit(s.best.value)), 1.0 / (SCAN_POINTS + 1))
+    for round_ in range(max(len(ZOOM_ROUNDS), ROUGH_ROUNDS)):
+        jobs = [(s, v) for s in smooth if round_ < len(ZOOM_ROUNDS) for v in _zoom(s, ZOOM_ROUNDS[round_])]
+        jobs += [(s, v) for s in rough if round_ < ROUGH_ROUNDS for v in _window_values(s)]
+        evaluate_points(evaluator, record, sensors, jobs, document)
+        for s in rough if round_ < ROUGH_ROUNDS else []:
+            centre, half = s.window
+            s.smoothed = _smoothed_minimum(s, centre, half)
+            s.window = (s.smoothed[0], half / 2.0)
+    jobs = [(s, v) for s in smooth if (v := profile_vertex(s)) is not None]
+    jobs += [(s, float(s.candidate.from_unit(s.smoothed[0]))) for s in rough]
+    evaluate_points(evaluator, record, sensors, jobs, document)
     for s in chosen:
         s.fitted = True
+
+
+def _window_values(scored: Scored) -> list[float]:
+    """ROUGH_POINTS values evenly spread inside the rough candidate's window (ends excluded), within the bounds."""
+    centre, half = scored.window
+    units = centre + half * np.linspace(-1.0, 1.0, ROUGH_POINTS + 2)[1:-1]
+    return [float(scored.candidate.from_unit(u)) for u in units if 0.0 <= u <= 1.0]
+
+
+def _smoothed_minimum(scored: Scored, centre: float, half: float) -> tuple[float, float]:
+    """Minimum of the profile smoothed over [centre − half, centre + half] (unit range): the vertex of a
+    least-squares parabola a (u − v)² + c through every run in it, and its uncertainty √(σ_v² + s/a): σ_v the
+    vertex's standard error (delta method, the comb's scatter about the parabola taken as the noise), √(s/a)
+    the half-width where the parabola rises by s, the RMS of that scatter (values the comb does not tell
+    apart). When the parabola is not convex or its vertex leaves the window: the lowest run in the window,
+    with the window's half-width as the uncertainty."""
+    points = [p for p in scored.points if p.fit is not None]
+    units = scored.candidate.to_unit([p.value for p in points])
+    chi = np.array([p.chi_square for p in points])
+    inside = np.abs(units - centre) <= half * (1.0 + 1e-9)
+    if inside.sum() >= 6:  # polyfit's covariance needs more points than coefficients + 2
+        coefficients, covariance = np.polyfit(units[inside] - centre, chi[inside], 2, cov=True)
+        a, b, _ = coefficients
+        vertex = -b / (2.0 * a) if a > 0.0 else np.inf
+        if abs(vertex) <= half:
+            gradient = np.array([b / (2.0 * a * a), -1.0 / (2.0 * a), 0.0])
+            scatter = np.sqrt(np.mean((chi[inside] - np.polyval(coefficients, units[inside] - centre)) ** 2))
+            error = float(np.sqrt(max(gradient @ covariance @ gradient, 0.0) + scatter / a))
+            return float(np.clip(centre + vertex, 0.0, 1.0)), error
+    lowest = np.flatnonzero(inside)[np.argmin(chi[inside])] if inside.any() else int(np.argmin(chi))
+    return float(units[lowest]), half
 
 
 def profile_vertex(scored: Scored) -> float | None:
@@ -219,9 +279,9 @@ def judge(scored: list[Scored], baseline: Fit, record: Record) -> list[Scored]:
         if s.best is None:
             continue
         s.allowance = max(1.0, s.best.chi_square / max(record.effective_samples, 1.0))
-        s.bic = s.estimate.chi_square + penalty
+        s.bic = s.best.chi_square + penalty  # the evidence: the best any run did (a rough candidate's estimate is its smoothed minimum)
         s.delta_bic = s.bic - baseline.chi_square
-        s.interval = interval(s, record)
+        s.interval = interval(s, record) if s.smoothed is None else smoothed_interval(s)
     ranked = sorted(scored, key=lambda s: (not s.fitted, s.bic))
     return ranked
 
@@ -240,6 +300,13 @@ def interval(scored: Scored, record: Record) -> tuple[float, float]:
     low_u = 0.5 * (units[lo] + units[lo - 1]) if lo > 0 else 0.0
     high_u = 0.5 * (units[hi] + units[hi + 1]) if hi + 1 < len(units) else 1.0
     return float(scored.candidate.from_unit(low_u)), float(scored.candidate.from_unit(high_u))
+
+
+def smoothed_interval(scored: Scored) -> tuple[float, float]:
+    """A rough candidate's interval: the smoothed profile's vertex ± its uncertainty, within the bounds."""
+    vertex, error = scored.smoothed
+    low, high = np.clip([vertex - error, vertex + error], 0.0, 1.0)
+    return float(scored.candidate.from_unit(low)), float(scored.candidate.from_unit(high))
 
 
 def mark_ties(ranked: list[Scored], all_sensors_scale: dict[str, float]) -> None:

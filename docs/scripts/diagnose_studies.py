@@ -31,6 +31,8 @@ UHV_BENCH = ["--sensors", "sealing_rod_displacement,turn_arm_angular_velocity", 
              "--lowpass", "2kHz", "--trigger-offset", "0.7ms"]
 CRANK_BENCH = ["--sensors", "slider_displacement,slider_velocity", "--rate", "50kHz", "--lowpass", "10kHz",
                "--trigger-offset", "0.1ms"]
+UHV_CONTACT = ["--sensors", "contact_displacement,contact_velocity", *UHV_BENCH[2:]]  # the moving contact's sensors
+FRICTION_J = ["--candidates", "friction,clearance,restitution"]
 FRICTIONLESS_UHV = ["defaults.friction={law: none}", "joints.A.clearance=0", "joints.J.clearance=0"]
 AMBROSIO_UHV = ["defaults.friction={law: ambrosio, mu_d: 0.16, v_0: 1e-3, v_1: 1e-2}", "joints.A.clearance=0.1mm",
                 "joints.J.clearance=0.1mm", "solver.rtol=1e-6", "solver.output_rate=30kHz"]
@@ -61,8 +63,9 @@ STUDIES = [
           seed=5),
     Study("uhv-no-effect", UHV, FRICTIONLESS_UHV, [], "none", UHV_BENCH, "0.05%", ["--candidates", "clearance,drive"], seed=6),
     Study("uhv-friction-J", UHV, AMBROSIO_UHV, ["joints.J.friction.mu_d=0.3"], "friction J μ_d 0.3",
-          ["--sensors", "contact_displacement,contact_velocity", *UHV_BENCH[2:]], "0.05%",
-          ["--candidates", "friction,clearance,restitution"], seed=5),
+          UHV_CONTACT, "0.05%", FRICTION_J, seed=5),
+    Study("uhv-friction-J-200Hz", UHV, AMBROSIO_UHV, ["joints.J.friction.mu_d=0.3"], "friction J μ_d 0.3, `--lowpass 200Hz`",
+          UHV_CONTACT, "0.05%", [*FRICTION_J, "--lowpass", "200Hz"], seed=5),
     Study("crank-clearance", SLIDER_CRANK, ["joints.slider_pin.clearance=0"], ["joints.slider_pin.clearance=0.2mm"],
           "clearance slider_pin 0.2 mm", CRANK_BENCH, "0.5%", ["--candidates", "clearance,drive,mass"]),
     Study("crank-friction", FRICTION_CRANK, [], ["joints.slider_pin.friction.mu_d=0.1"], "friction slider_pin μ_d 0.1",

@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from clearsim.cli import app
 from clearsim.runner import summarize
-from clearsim.sweep import LocalPool, SweepFailed, SweepRequest, plan_sweep, run_sweep
+from clearsim.sweep import LocalPool, SweepRequest, plan_sweep, run_sweep
 
 CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
 SLIDER_CRANK = CONFIGS / "slider_crank_flores.yaml"
@@ -55,7 +55,7 @@ def test_peak_acceleration_and_contact_force_grow_with_the_clearance(pool_sweep)
     rows = read_summary(pool_sweep[0])
     ideal, small, large = (rows[c] for c in CASES)
     peak = [float(row["peak_acceleration_m_s2"]) for row in (ideal, small, large)]
-    force = [float(row[f"max_contact_force_N[slider_pin]"]) for row in (small, large)]
+    force = [float(row["max_contact_force_N[slider_pin]"]) for row in (small, large)]
     assert peak[0] < peak[1] < peak[2]
     assert force[0] < force[1]
     assert float(small["acceleration_ratio"]) == pytest.approx(peak[1] / peak[0], rel=1e-12)
@@ -115,7 +115,7 @@ def test_a_failing_case_is_recorded_and_the_others_finish(tmp_path):
                     "--set", "solver.min_step=1e-12s,5e-5s", "--workers", 2, "-o", out)
     assert result.exit_code == 2, result.output
     failing = "clearance-0.5_mm__solver.min_step-5e-5s"
-    assert f"1 of 4 cases failed" in result.output and f"{failing}: at t = " in result.output
+    assert "1 of 4 cases failed" in result.output and f"{failing}: at t = " in result.output
     rows = read_summary(out)
     assert [rows[c]["status"] for c in rows] == ["complete", "complete", "complete", "failed"]
     assert "step size fell below solver.min_step" in rows[failing]["error"]

@@ -2,7 +2,6 @@
 
 import h5py
 import numpy as np
-import pytest
 import yaml
 
 from clearsim.io.hdf5 import read_result

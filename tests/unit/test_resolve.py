@@ -127,6 +127,17 @@ def test_stiction_step_speeds_are_v_low_and_v_high():
     assert (p.friction_law, p.mu_s, p.mu_d, p.v_low, p.v_high) == ("stiction_step", 0.2, 0.16, 1e-4, 1e-2)
 
 
+def test_sticking_is_exact_by_default_smooth_on_request_and_only_for_laws_that_stick():
+    d = defaults(bearing_radius="10 mm", friction=TABLE_2_FRICTION)
+    assert resolve_clearance(joint(clearance="0.1 mm"), d).stick == "exact"
+    assert resolve_clearance(joint(clearance="0.1 mm", friction={"stick": "smooth"}), d).stick == "smooth"
+    coulomb = resolve_clearance(joint(clearance="0.1 mm", friction={"law": "coulomb", "mu_d": 0.1}), d)
+    assert coulomb.stick == "exact"
+    error = resolve_error(joint(clearance="0.1 mm", friction={"law": "ambrosio", "mu_d": 0.1, "v_0": "0.1 mm/s",
+                                                              "v_1": "1 mm/s", "stick": "exact"}))
+    assert "does not use stick" in error.message and "stiction_step" in error.hint
+
+
 def test_ambrosio_speeds_are_v_low_and_v_high():
     friction = {"law": "ambrosio", "mu_d": 0.1, "v_0": "0.1 mm/s", "v_1": "1 mm/s"}
     p = resolve_clearance(joint(clearance="0.1 mm", friction=friction), defaults(bearing_radius="10 mm"))

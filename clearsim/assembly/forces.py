@@ -67,6 +67,12 @@ def clearance_kinematics(system, k, q, qd):
 
 
 @njit(cache=True)
+def exact_stick(system, k):
+    """Joint k sticks by a constraint (its friction law has the `exact` stick treatment)."""
+    return system.clearance_laws[k, 2] == STICK_EXACT
+
+
+@njit(cache=True)
 def stick_row(system, k, q, qd):
     """Stick constraint v_t = G q̇ = 0 of joint k: (G's bearing block, G's journal block, Ġ q̇).
 
@@ -100,7 +106,7 @@ def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact
     force = normal_force(system.clearance_laws[k, 0], penetration, rate, guarded_speed,
                          p[CL_STIFFNESS], p[CL_EXPONENT], p[CL_RESTITUTION])
     law = system.clearance_laws[k, 1]
-    if system.clearance_laws[k, 2] != STICK_EXACT:
+    if not exact_stick(system, k):
         mu = friction_coefficient(law, sliding, p[CL_MU_S], p[CL_MU_D], p[CL_V_LOW], p[CL_V_HIGH])
     elif mode == STICK:
         mu = 0.0  # the stick constraint's multiplier carries the friction force

@@ -30,9 +30,9 @@ from clearsim.assembly.dynamics import (
     stick_row_index,
 )
 from clearsim.assembly.forces import (
-    CONTACT, FREE, SLIDE_BACK, STICK, clearance_kinematics, contact_force_magnitudes,
+    CONTACT, FREE, SLIDE_BACK, STICK, clearance_kinematics, contact_force_magnitudes, exact_stick,
 )
-from clearsim.physics.friction import STICK_EXACT, static_coefficient
+from clearsim.physics.friction import static_coefficient
 from clearsim.solver.dopri import STAGES, error_norm, interpolate, step
 
 # real_state slots
@@ -61,12 +61,6 @@ DEEPEST_PENETRATION = 0.05  # of the journal radius: beyond it no contact law me
 def hysteresis(system, k):
     """ε of the loss event of joint k (m): far above round-off of e (~1e-16 m), far below any penetration."""
     return 1e-12
-
-
-@njit(cache=True)
-def exact_stick(system, k):
-    """Joint k sticks by a constraint (its friction law has the `exact` stick treatment)."""
-    return system.clearance_laws[k, 2] == STICK_EXACT
 
 
 @njit(cache=True)

@@ -20,7 +20,7 @@ from clearsim.errors import InputError, SolverError
 from clearsim.io.hdf5 import ResultWriter, group_attribute, interrupts_deferred, keep_existing, read_result
 from clearsim.model.loader import LoadedMechanism, load_mechanism
 from clearsim.solver.outputs import classify_episodes, chunk_outputs, sample_modes
-from clearsim.solver.simulate import Run
+from clearsim.solver.simulate import Run, Statistics
 
 BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
 DEFAULT_OUTPUT = Path("results") / "run.h5"
@@ -84,11 +84,12 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     """
     output = Path(output)
     backup = keep_existing(output)
-    run = Run(system)
+    run = None  # made inside the try: loading the compiled kernels can take seconds, and may be interrupted
     episodes, status, complete, error = [], "complete", True, None
     with ResultWriter(output, loaded.resolved_yaml, _attributes(system, loaded)) as writer:
         pending = _PendingChunks(writer, episodes)
         try:
+            run = Run(system)
             initial_energy = None
             for chunk in run.chunks():
                 if initial_energy is None:
@@ -100,13 +101,14 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
         except SolverError as exc:
             status, complete, error = f"failed: {exc}", False, exc
         except KeyboardInterrupt as exc:
-            status, complete, error = f"interrupted at t = {run.time * 1e3:.3f} ms", False, exc
+            at = run.time if run is not None else 0.0
+            status, complete, error = f"interrupted at t = {at * 1e3:.3f} ms", False, exc
         finally:
             pending.flush()
             if episodes:
                 _write_episodes(writer, system, run, np.concatenate(episodes))
-            writer.finish(complete, status, _final_attributes(run))
-    return RunReport(output, backup, complete, status, run.statistics(), error)
+            writer.finish(complete, status, _final_attributes(run) if run is not None else {})
+    return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error)
 
 
 FLUSH_SECONDS = 0.5

@@ -51,9 +51,12 @@ SWEEPS = {
     # case 5 for the UHV model (the file's A and J at 0.01 mm): tolerance, then output rate
     "uhv_rtol": ["--set", "solver.rtol=1e-6,1e-7,1e-8,1e-9"],
     "uhv_rate": ["--set", "solver.output_rate=100kHz,1MHz"],
+    # case 5 for the other clearances of case 6: the a_and_j sweep again at rtol 1e-9
+    "a_and_j_rtol": ["--clearance", "0.03,0.05,0.1", "--joints", "A,J", "--set", "solver.rtol=1e-9"],
 }
 SWEPT = {"friction": "defaults.friction.mu_d", "friction_rtol": "defaults.friction.mu_d",
          "uhv_rtol": "solver.rtol", "uhv_rate": "solver.output_rate"}
+DEFAULT_RTOL, TIGHT_RTOL = "1e-7", "1e-9"
 
 PAPER = {  # Meng et al. 2015, section 4 (quoted in DESIGN.md §5 / issue 7); missing: not given in the text
     "j_only": {"0.01": {"acceleration_ratio": 3.58}},
@@ -84,6 +87,7 @@ def run_sweep(name, out, workers, stick=None):
     folder = out / name
     command = ["clearsim", "sweep", str(CONFIG), *sweep_arguments(name, stick), "--out", str(folder), "--workers", str(workers)]
     print(f"$ {' '.join(command)}", file=sys.stderr)
+    command[:1] = [sys.executable, "-m", "clearsim.cli"]  # the clearsim this script imports, not whichever is installed
     subprocess.run(command, check=False, stdout=subprocess.DEVNULL)  # a failed case shows in its row
     with open(folder / "summary.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
@@ -325,6 +329,72 @@ def print_friction(studies):
                   f"{float(data['energy/friction_dissipated'][-1]):.2f} | {row['status']} |")
 
 
+def tolerance_figures(row, ideal):
+    """Figures of merit compared between tolerances: peak |a| over the stroke and over the first 10 ms,
+    start delay at 50 % and 1 % of the ideal peak speed (ms), located peak F_n at A and J (N), 99th percentile
+    of |a|, end error (%)."""
+    data = result(row)
+    return {"peak": float(row["peak_acceleration_m_s2"]), "peak_10ms": window_peak(data),
+            "delay_50": delay_ms(data, result(ideal), 0.5), "delay_1": delay_ms(data, result(ideal), 0.01),
+            "force_A": float(row["max_contact_force_N[A]"]), "force_J": float(row["max_contact_force_N[J]"]),
+            "p99": percentile_99(data), "end_error": float(row["end_error_percent"]), "steps": int(row["steps"])}
+
+
+def _relative(value, reference):
+    change = (value / reference - 1) * 100
+    return "0.00 %" if abs(change) < 0.005 else f"{change:+.2f} %"
+
+
+def uhv_tolerance_pairs(studies):
+    """(clearance label, rtol, figures, figures at rtol 1e-9) for A and J at every clearance of case 6 at the
+    default rtol and at 1e-9, then the 0.01 mm case at every tolerance of uhv_rtol."""
+    tight = {row["clearance"]: tolerance_figures(row, ideal_row(studies["a_and_j_rtol"]))
+             for row in case_rows(studies["a_and_j_rtol"])}
+    by_rtol = {}
+    for row in case_rows(studies["uhv_rtol"]):
+        ideal = next(r for r in studies["uhv_rtol"] if not r["reference"] and r["solver.rtol"] == row["solver.rtol"])
+        by_rtol[row["solver.rtol"]] = tolerance_figures(row, ideal)
+    tight["0.01 mm"] = by_rtol[TIGHT_RTOL]
+    pairs = [("0.01 mm", DEFAULT_RTOL, by_rtol[DEFAULT_RTOL], tight["0.01 mm"])]
+    pairs += [(row["clearance"], DEFAULT_RTOL, tolerance_figures(row, ideal_row(studies["a_and_j"])),
+               tight[row["clearance"]]) for row in case_rows(studies["a_and_j"]) if row["clearance"] != "0.01 mm"]
+    return pairs, by_rtol
+
+
+def print_uhv_tolerance(studies):
+    """Case 5c: the UHV model's tolerance study (A and J at 0.01 mm, rtol 1e-6 … 1e-9), the default rtol against
+    1e-9 at every clearance of case 6, and the largest deviation of each figure at the default rtol."""
+    pairs, by_rtol = uhv_tolerance_pairs(studies)
+    reference = by_rtol[TIGHT_RTOL]
+    print("\n| rtol | steps | peak \\|a\\| (m/s²) | rel. to 1e-9 | first 10 ms (m/s²) | rel. | start delay f = 0.5 / 0.01 (ms) "
+          "| max F_n A (kN) | rel. | max F_n J (kN) | rel. |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for rtol, f in by_rtol.items():
+        print(f"| {rtol}{' (default)' if rtol == DEFAULT_RTOL else ''} | {f['steps']} | {f['peak']:.1f} "
+              f"| {_relative(f['peak'], reference['peak'])} | {f['peak_10ms']:.1f} "
+              f"| {_relative(f['peak_10ms'], reference['peak_10ms'])} | {f['delay_50']:.3f} / {f['delay_1']:.3f} "
+              f"| {f['force_A'] / 1e3:.2f} | {_relative(f['force_A'], reference['force_A'])} | {f['force_J'] / 1e3:.2f} "
+              f"| {_relative(f['force_J'], reference['force_J'])} |")
+    print(f"\n| c at A and J | peak \\|a\\| rtol {DEFAULT_RTOL} / {TIGHT_RTOL} (m/s²) | rel. | first 10 ms (m/s²) | rel. "
+          "| start delay f = 0.01 (ms) | max F_n A (kN) | rel. | max F_n J (kN) | rel. | 99th pct \\|a\\| (m/s²) "
+          "| end error (%) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    worst = {}
+    for clearance, rtol, f, t in pairs:
+        print(f"| {clearance} | {f['peak']:.1f} / {t['peak']:.1f} | {_relative(f['peak'], t['peak'])} "
+              f"| {f['peak_10ms']:.1f} / {t['peak_10ms']:.1f} | {_relative(f['peak_10ms'], t['peak_10ms'])} "
+              f"| {f['delay_1']:.3f} / {t['delay_1']:.3f} | {f['force_A'] / 1e3:.2f} / {t['force_A'] / 1e3:.2f} "
+              f"| {_relative(f['force_A'], t['force_A'])} | {f['force_J'] / 1e3:.2f} / {t['force_J'] / 1e3:.2f} "
+              f"| {_relative(f['force_J'], t['force_J'])} | {f['p99']:.0f} / {t['p99']:.0f} "
+              f"| {f['end_error']:.3f} / {t['end_error']:.3f} |")
+        for key in ("peak", "peak_10ms", "force_A", "force_J", "p99"):
+            worst[key] = max(worst.get(key, 0.0), abs(f[key] / t[key] - 1) * 100)
+        worst["delay_1"] = max(worst.get("delay_1", 0.0), abs(f["delay_1"] - t["delay_1"]) * 1e3)
+    print(f"\n(largest deviation at rtol {DEFAULT_RTOL} from {TIGHT_RTOL} over the four clearances: peak |a| "
+          f"{worst['peak']:.2f} %, first 10 ms {worst['peak_10ms']:.2f} %, max F_n at A {worst['force_A']:.2f} %, at J "
+          f"{worst['force_J']:.2f} %, start delay f = 0.01 {worst['delay_1']:.1f} µs, 99th percentile {worst['p99']:.0f} %)")
+
+
 def whirl_cases(studies):
     """(label, row) of every case whose journal-centre orbit at J is compared with rolling."""
     cases = [("J only, 0.01 mm", row_where(studies["j_only"], "clearance", 0.01))]
@@ -540,6 +610,7 @@ def main():
         print(f"- `{command_text(name, stick)}`")
     print_paper_vs_clearsim(studies)
     print_start_delays(studies["a_and_j"])
+    print_uhv_tolerance(studies)
     print_friction(studies)
     print_whirl(studies)
     print_onsets(studies["a_and_j"])

@@ -28,21 +28,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from paper_studies import (
-    CONFIG,
-    FIGURES,
-    PAPER,
-    ROOT,
-    delay_ms,
-    friction_by_joint,
-    new_figure,
-    percentile_99,
-    window_peak,
-)
+from paper_studies import (CONFIG, FIGURES, PAPER, ROOT, delay_ms, friction_by_joint,  # noqa: E402
+                           new_figure, percentile_99, window_peak)
 
-from clearsim.io.hdf5 import NotAResultFile, read_result
-from clearsim.model.loader import load_mechanism
-from clearsim.runner import prepare, run_to_file, summarize
+from clearsim.io.hdf5 import NotAResultFile, read_result  # noqa: E402
+from clearsim.model.loader import load_mechanism  # noqa: E402
+from clearsim.runner import prepare, run_to_file, summarize  # noqa: E402
 
 MU_D = ("0.10", "0.15", "0.16")
 CLEARANCE_MM = 0.1
@@ -90,7 +81,8 @@ def run_case(folder, name, overrides):
 def figures_of_merit(path, ideal):
     """Per run: peak |a| over the stroke and over 0–10 ms, 99th percentile of |a|, RMS of a − a_ideal (the
     'fluctuation'), start delay at 1 % of the ideal peak speed, velocity at the end of the stroke, end
-    displacement − ideal (mm), friction energy (J) and its share at A, located peak F_n at A and J (kN)."""
+    displacement − ideal (mm), friction energy (J) and its share at A, the energy dissipated in the contacts (J),
+    the driver's work minus that of the ideal stroke (J), located peak F_n at A and J (kN)."""
     data = read_result(path)
     if not bool(data["attrs"].get("complete")):
         return None
@@ -104,15 +96,19 @@ def figures_of_merit(path, ideal):
             "v_end": float(data["sensors/contact_velocity"][-1]),
             "x_end_mm": float(data["sensors/contact_displacement"][-1] - ideal["sensors/contact_displacement"][-1]) * 1e3,
             "friction_J": float(data["energy/friction_dissipated"][-1]),
-            "share_A": energy_a / (energy_a + energy_j) * 100, "force_A": forces["A"] / 1e3, "force_J": forces["J"] / 1e3}
+            "share_A": energy_a / (energy_a + energy_j) * 100, "contact_J": float(data["energy/contact_dissipated"][-1]),
+            "driver_extra": float(data["energy/driver_work"][-1] - ideal["energy/driver_work"][-1]),
+            "force_A": forces["A"] / 1e3, "force_J": forces["J"] / 1e3}
 
 
 LABELS = {"peak": "peak \\|a\\|, stroke (m/s²)", "peak_10ms": "peak \\|a\\|, 0–10 ms (m/s²)",
           "p99": "99th pct \\|a\\| (m/s²)", "rms_dev": "RMS of a − a_ideal (m/s²)", "delay_1": "start delay f = 0.01 (ms)",
           "v_end": "v at 85 ms (m/s)", "x_end_mm": "x − x_ideal at 85 ms (mm)", "friction_J": "friction energy (J)",
-          "share_A": "share at A (%)", "force_A": "max F_n A (kN)", "force_J": "max F_n J (kN)"}
+          "share_A": "share at A (%)", "contact_J": "contact dissipation (J)",
+          "driver_extra": "driver work − ideal (J)", "force_A": "max F_n A (kN)", "force_J": "max F_n J (kN)"}
 FORMATS = {"peak": ".0f", "peak_10ms": ".0f", "p99": ".0f", "rms_dev": ".1f", "delay_1": ".3f", "v_end": ".3f",
-           "x_end_mm": ".3f", "friction_J": ".1f", "share_A": ".1f", "force_A": ".1f", "force_J": ".1f"}
+           "x_end_mm": ".3f", "friction_J": ".1f", "share_A": ".1f", "contact_J": ".1f",
+           "driver_extra": ".1f", "force_A": ".1f", "force_J": ".1f"}
 PAIRED = ("peak", "peak_10ms", "p99", "rms_dev", "friction_J", "force_A", "force_J")
 
 
@@ -172,7 +168,17 @@ def print_spread_vs_trend(figures):
           f"{times[~early].max():.2f} ms) in the others)")
     print(f"\n(peak |a| over the stroke: the sample spread at μ_d = 0.10 is {spread:.0f} % (std/mean); one unrelated "
           f"draw per μ_d shows a lower peak at 0.16 in {falls:.0f} % of the pairings, the same draw in {paired:.0f} % "
-          f"of the samples; the paper's fall is {(PAPER['friction']['0.16']['peak_acceleration_m_s2'] / PAPER['friction']['0.10']['peak_acceleration_m_s2'] - 1) * 100:.1f} %)")
+          f"of the samples, by at most {-np.min(after / before - 1) * 100:.1f} %; the paper's fall is {(PAPER['friction']['0.16']['peak_acceleration_m_s2'] / PAPER['friction']['0.10']['peak_acceleration_m_s2'] - 1) * 100:.1f} %)")
+
+
+def print_same_impact(figures):
+    """Paired peaks split by whether the peak is the same impact at μ_d 0.10 and 0.16 (times within 0.1 ms)."""
+    change = np.array([(b["peak"] / a["peak"] - 1) * 100 for a, b in zip(figures["0.10"], figures["0.16"])])
+    same = np.array([abs(a["t_peak_ms"] - b["t_peak_ms"]) < 0.1 for a, b in zip(figures["0.10"], figures["0.16"])])
+    print(f"\n(μ_d 0.10 → 0.16, peak |a|: where it is the same impact at both ({same.sum()} samples) it changes by "
+          f"{np.min(change[same]):+.1f} … {np.max(change[same]):+.1f} %, median {np.median(change[same]):+.1f} %; where "
+          f"it moves to another impact ({(~same).sum()} samples) by " + ", ".join(f"{c:+.1f}" for c in sorted(change[~same]))
+          + " %)")
 
 
 def ensemble_figure(figures, nominal):
@@ -233,6 +239,7 @@ def main():
     print_distributions(figures, nominal)
     print_paired(figures)
     print_spread_vs_trend(figures)
+    print_same_impact(figures)
     if "--figures" in arguments:
         ensemble_figure(figures, nominal)
 

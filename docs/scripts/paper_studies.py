@@ -1,15 +1,18 @@
 """Cases 6 and 5c of docs/validation.md: the seed paper's studies (Meng et al. 2015) on the reconstructed UHV
-model, and the UHV tolerance / output-rate study.
+model, and the UHV tolerance / output-rate study (A and J at every clearance of case 6).
 
     python docs/scripts/paper_studies.py [OUT] [--figures] [--workers N] [--stick smooth|exact]
         (sweep folders under OUT, default /tmp/clearsim-paper[-STICK]; --stick smooth: the friction law as
-        written, the stiction band through zero — the numbers of the session-2 text of §6)
+        written, the stiction band through zero: the smooth-law numbers quoted in §6; ≈ 8 min with --workers 1)
 
 Runs the `clearsim sweep`s of SWEEPS on configs/uhv_breaker.yaml and prints, from their summary.csv and
 result files: the detailed table, the "paper vs clearsim" table, the start delay at several thresholds,
-the friction study (per joint), the whirl of J, and where on the bearings the contact episodes begin.
-The runs take 7.5 min of integration in all (the slowest, 20–70 s each, are the whirling and 0.1 mm cases
-and the Coulomb run), ≈ 5 min on 2 cores. Re-running resumes (finished cases are reused, ≈ 1 min). Only --figures writes in the repo (docs/figures/validation-paper-*.png).
+the UHV tolerance study, the friction study (per joint), the whirl of J, and where on the bearings the contact
+episodes begin.
+The runs take ≈ 30 s of integration in all (0.2–2 s each; with --stick smooth much longer, the stiction band
+holds the steps near 1e-7 s), ≈ 1.5 min with --workers 1 including each sweep's start-up. Re-running resumes
+(finished cases are reused, ≈ 20 s). Only --figures writes in the repo (docs/figures/validation-paper-*.png).
+The friction ensemble of §6 is docs/scripts/friction_ensemble.py, which reuses the figures of merit below.
 """
 
 import csv
@@ -337,7 +340,9 @@ def tolerance_figures(row, ideal):
     return {"peak": float(row["peak_acceleration_m_s2"]), "peak_10ms": window_peak(data),
             "delay_50": delay_ms(data, result(ideal), 0.5), "delay_1": delay_ms(data, result(ideal), 0.01),
             "force_A": float(row["max_contact_force_N[A]"]), "force_J": float(row["max_contact_force_N[J]"]),
-            "p99": percentile_99(data), "end_error": float(row["end_error_percent"]), "steps": int(row["steps"])}
+            "p99": percentile_99(data), "end_error": float(row["end_error_percent"]), "steps": int(row["steps"]),
+            "times_ms": [float(data["time"][np.argmax(signal)]) * 1e3 for signal in  # of the sampled peaks
+                         (acceleration(data), data["joints/A/normal_force"], data["joints/J/normal_force"])]}
 
 
 def _relative(value, reference):
@@ -390,6 +395,9 @@ def print_uhv_tolerance(studies):
         for key in ("peak", "peak_10ms", "force_A", "force_J", "p99"):
             worst[key] = max(worst.get(key, 0.0), abs(f[key] / t[key] - 1) * 100)
         worst["delay_1"] = max(worst.get("delay_1", 0.0), abs(f["delay_1"] - t["delay_1"]) * 1e3)
+    print("\n(time of the sampled peak |a| / F_n at A / F_n at J, ms, at rtol " + f"{DEFAULT_RTOL} and {TIGHT_RTOL}: "
+          + "; ".join(f"{c}: " + ", ".join(f"{x:.2f}/{y:.2f}" for x, y in zip(f["times_ms"], t["times_ms"]))
+                      for c, _, f, t in pairs) + ")")
     print(f"\n(largest deviation at rtol {DEFAULT_RTOL} from {TIGHT_RTOL} over the four clearances: peak |a| "
           f"{worst['peak']:.2f} %, first 10 ms {worst['peak_10ms']:.2f} %, max F_n at A {worst['force_A']:.2f} %, at J "
           f"{worst['force_J']:.2f} %, start delay f = 0.01 {worst['delay_1']:.1f} µs, 99th percentile {worst['p99']:.0f} %)")
@@ -420,6 +428,26 @@ def print_whirl(studies):
         modes = "/".join(fmt(row.get(f"{m}_percent[J]"), ".0f") for m in ("free", "impact", "contact"))
         print(f"| {label} | {turns:.1f} | {rolling:.1f} | {frequency:.0f} | {mean_e:.2f} | {slip:.1f} | {modes} "
               f"| {fmt(row['peak_acceleration_m_s2'], '.1f')} | {status_text(row)} |")
+
+
+def print_whirl_details(studies):
+    """The whirl of J at 0.01 mm (A and J): when the board's rotation reverses and the orbit locks on, the orbit rate
+    at 60 ms, and the contact force and penetration while it whirls."""
+    data = result(row_where(studies["a_and_j"], "clearance", 0.01))
+    bearing, _, _, clearance = joint_bodies(data, "J")
+    t, omega = data["time"], data[f"bodies/{bearing}/qd"][:, 2]
+    reversal = t[1:][(np.diff(np.sign(omega)) != 0) & (t[1:] > 0.005) & (t[1:] < 0.08)][0]
+    e = data["joints/J/eccentricity"]
+    rate = np.convolve(np.gradient(np.unwrap(np.arctan2(e[:, 1], e[:, 0])), t) / (2 * np.pi), np.ones(100) / 100,
+                       mode="same")  # 1 ms running mean, as in the whirl figure
+    locked = t[(np.abs(rate) > 1000.0) & (t > reversal)][0]
+    window = (t >= 0.055) & (t <= 0.065)
+    print(f"\n(A and J, 0.01 mm: the {bearing.replace('_', ' ')} turns at up to {np.max(np.abs(omega)):.1f} rad/s and "
+          f"reverses at {reversal * 1e3:.1f} ms; the orbit rate of e at J exceeds 1 kHz from {locked * 1e3:.1f} ms and is "
+          f"{abs(rate[np.searchsorted(t, 0.060)]):.0f} Hz at 60 ms; at 55–65 ms the mean F_n at J is "
+          f"{np.mean(data['joints/J/normal_force'][window]) / 1e3:.1f} kN and the mean penetration "
+          f"{np.mean(data['joints/J/penetration'][window]) * 1e6:.1f} µm ({np.mean(data['joints/J/penetration'][window]) / clearance:.2f} c); "
+          f"the largest penetration is {np.max(data['joints/J/penetration']) / clearance:.2f} c)")
 
 
 def status_text(row):
@@ -613,6 +641,7 @@ def main():
     print_uhv_tolerance(studies)
     print_friction(studies)
     print_whirl(studies)
+    print_whirl_details(studies)
     print_onsets(studies["a_and_j"])
     if "--figures" in arguments:
         print()

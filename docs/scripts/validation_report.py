@@ -6,7 +6,7 @@ Run from the repository root:
 
 --figures also writes docs/figures/validation-orbit.png (independent model vs clearsim, journal
 path over the first crank revolution). Runtime ≈ 32 s on 2 cores (numba kernels cached); no UHV clearance
-runs here (each takes ~12 s; see docs/scripts/paper_studies.py).
+runs here (they are in docs/scripts/paper_studies.py, cases 5c and 6).
 
 The references are the test-support codes, written separately from the assembler:
 tests/support/uhv_loop_closure.py (position analysis of the UHV geometry by circle intersections),

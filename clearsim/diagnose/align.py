@@ -30,6 +30,7 @@ COMPARISON_FILTER_ORDER = 4
 BANDWIDTH_DROP = 0.1  # the bench bandwidth ends where the noise floor has fallen to 10 % of its level
 COMPARISON_BANDWIDTH = 500.0  # Hz: the motion and its lag, below the chaotic detail of single impacts
 MAX_OFFSET_FRACTION = 0.1  # the trigger offset is searched within ±10 % of the record length
+LOW_BAND_FACTOR = 0.4  # the screening band: 0.4 × the comparison band (frequency continuation, docs/diagnose.md §4)
 
 
 @dataclass(frozen=True)
@@ -137,6 +138,7 @@ class Record:
     values: dict[str, np.ndarray]
     noise: dict[str, NoiseEstimate]
     cutoff: float | None  # comparison low-pass (Hz) applied to the model's prediction, None: none
+    low_band: "Record | None" = None  # the same record in the screening band (LOW_BAND_FACTOR × cutoff)
 
     @property
     def weights(self) -> dict[str, float]:
@@ -150,7 +152,8 @@ class Record:
 
 def prepare_record(time: np.ndarray, values: dict[str, np.ndarray], cutoff: float | None = None) -> Record:
     """Resample onto a uniform grid (the record's median step), estimate each sensor's noise, and
-    low-pass the record at the comparison bandwidth (model predictions get the same filter).
+    low-pass the record at the comparison bandwidth (model predictions get the same filter); the
+    record in the screening band (LOW_BAND_FACTOR × that bandwidth) rides along as `low_band`.
 
     cutoff: the comparison bandwidth (Hz); None: COMPARISON_BANDWIDTH, or the record's own
     bandwidth where that is narrower.
@@ -163,14 +166,23 @@ def prepare_record(time: np.ndarray, values: dict[str, np.ndarray], cutoff: floa
     if cutoff is None:
         seen = [n.bandwidth for n in noise.values() if n.bandwidth is not None]
         cutoff = min([COMPARISON_BANDWIDTH, *seen])
-    cutoff = cutoff if cutoff < 0.5 * rate else None
     for sensor, estimate in noise.items():
         if not estimate.std > 0.0:
-            estimate = NoiseEstimate(_quantisation_floor(uniform[sensor]), estimate.effective_samples,
-                                     estimate.samples, estimate.bandwidth)
-        noise[sensor] = estimate.filtered(cutoff, rate) if cutoff is not None else estimate
-        uniform[sensor] = lowpass(uniform[sensor], cutoff, rate)
-    return Record(grid, rate, uniform, noise, cutoff)
+            noise[sensor] = NoiseEstimate(_quantisation_floor(uniform[sensor]), estimate.effective_samples,
+                                          estimate.samples, estimate.bandwidth)
+    record = _in_band(grid, rate, uniform, noise, cutoff)
+    record.low_band = _in_band(grid, rate, uniform, noise, LOW_BAND_FACTOR * (record.cutoff or 0.5 * rate))
+    return record
+
+
+def _in_band(grid: np.ndarray, rate: float, uniform: dict[str, np.ndarray], noise: dict[str, NoiseEstimate],
+             cutoff: float) -> Record:
+    """The record low-passed at `cutoff` (none at or above Nyquist), with its noise seen through that filter."""
+    cutoff = cutoff if cutoff < 0.5 * rate else None
+    if cutoff is None:
+        return Record(grid, rate, dict(uniform), dict(noise), None)
+    return Record(grid, rate, {s: lowpass(v, cutoff, rate) for s, v in uniform.items()},
+                  {s: n.filtered(cutoff, rate) for s, n in noise.items()}, cutoff)
 
 
 def _quantisation_floor(values: np.ndarray) -> float:
@@ -242,6 +254,11 @@ def fit_offset(record: Record, model_time: np.ndarray, model: dict[str, np.ndarr
         refined = minimize_scalar(cost, bounds=(low, high), method="bounded", options={"xatol": 1e-3 * step})
         if refined.fun < scanned[best]:
             offset = float(refined.x)
+    return fit_at(record, model_time, model, offset)
+
+
+def fit_at(record: Record, model_time: np.ndarray, model: dict[str, np.ndarray], offset: float) -> Fit:
+    """χ² and gaps of the model at trigger offset `offset`."""
     residual = residuals(record, predict(record, model_time, model, offset))
     gaps = sensor_gaps(record, residual)
     return Fit(float(offset), chi_square(record, residual), gaps, combined_gap(gaps))

@@ -8,7 +8,10 @@ around its best point, never a gradient method:
              For a stiffness that sets a resonance (a compliance), two more rounds of values whose
              ringing frequency matches the record's residual peak (f ∝ √k): its cost is a narrow well
              (a few % wide) that no grid finds
-    scan     six more values over the range for the most promising candidates
+    scan     six more values over the range for the most promising candidates (chosen by χ² in the
+             comparison band and in the screening band, Record.low_band: frequency continuation)
+    valley   three values about the minimum of the profile in the screening band, where a clearance's
+             cost is a smooth valley (in the comparison band it can be narrower than a scan step)
     zoom     four, then two values between each of the two lowest local minima and their neighbours
     vertex   one value at the vertex of a parabola through the profile near its best point (the
              minimum with the chaotic scatter of single runs smoothed out)
@@ -36,7 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from clearsim.diagnose.align import Fit, Record, chi_square_halves, fit_offset, predict, residuals
+from clearsim.diagnose.align import Fit, Record, chi_square_halves, fit_at, fit_offset, predict, residuals
 from clearsim.diagnose.candidates import Candidate, with_effects
 from clearsim.diagnose.evaluate import Evaluator, Prediction
 from clearsim.diagnose.features import dominant_frequency
@@ -63,10 +66,15 @@ class Point:
     fit: Fit | None  # None: the run failed
     prediction: Prediction
     error: str = ""
+    low_band: Fit | None = None  # the fit in the record's screening band (Record.low_band)
 
     @property
     def chi_square(self) -> float:
         return self.fit.chi_square if self.fit is not None else np.inf
+
+    @property
+    def low_band_chi_square(self) -> float:
+        return self.low_band.chi_square if self.low_band is not None else np.inf
 
 
 @dataclass
@@ -115,8 +123,10 @@ def evaluate_points(evaluator: Evaluator, record: Record, sensors: list[str],
 def score_point(record: Record, sensors: list[str], value: float, prediction: Prediction) -> Point:
     if not prediction.ok:
         return Point(value, None, prediction, prediction.error)
-    fit = fit_offset(record, prediction.time, {s: prediction.sensors[s] for s in sensors})
-    return Point(value, fit, prediction)
+    model = {s: prediction.sensors[s] for s in sensors}
+    fit = fit_offset(record, prediction.time, model)
+    low_band = fit_at(record.low_band, prediction.time, model, fit.offset) if record.low_band is not None else None
+    return Point(value, fit, prediction, low_band=low_band)
 
 
 def aligned_residuals(record: Record, prediction: Prediction, offset: float) -> dict[str, np.ndarray]:
@@ -158,33 +168,43 @@ def seen_by_sensors(scored: Scored, baseline: float) -> bool:
     return any(p.fit is not None and abs(p.chi_square - baseline) > VISIBLE for p in scored.points)
 
 
-def to_fit(screened: list[Scored], baseline: Fit, record: Record, count: int) -> list[Scored]:
-    """The candidates to fit: the `count` with the lowest screening χ², and one more chosen by its
-    sensitivity (the largest |Δχ²| of its screening runs): the one whose sensitivity is nearest
-    above what is left to explain (χ² − n_eff), else the most sensitive. Two screening values rarely
-    hit the narrow valley of a clearance; a candidate whose change is of the size of the gap can
-    reach it, while one that barely moves χ² cannot explain the gap, however lucky its screening."""
+def to_fit(screened: list[Scored], baseline: Point, record: Record, count: int) -> list[Scored]:
+    """The candidates to fit: the `count` with the lowest screening χ², the `count` with the lowest χ² in
+    the screening band among those that lower it there (frequency continuation: below the chaotic detail of
+    single impacts a clearance's cost is smooth, so two screening values can tell a joint whose valley they
+    miss in the comparison band), and one more chosen by its sensitivity (the largest |Δχ²| of its
+    screening runs): the one whose sensitivity is nearest above what is left to explain (χ² − n_eff), else
+    the most sensitive. A candidate whose change is of the size of the gap can reach the valley, while one
+    that barely moves χ² cannot explain the gap, however lucky its screening."""
     by_screening = sorted(screened, key=lambda s: s.best.chi_square)
     chosen = by_screening[:count]
+    lowering = [s for s in screened if low_band_best(s) < baseline.low_band_chi_square - VISIBLE]
+    chosen += [s for s in sorted(lowering, key=low_band_best)[:count] if s not in chosen]
     excess = max(baseline.chi_square - record.effective_samples, 0.0)
 
     def sensitivity(s: Scored) -> float:
         return max(abs(p.chi_square - baseline.chi_square) for p in s.points if p.fit is not None)
 
-    rest = [s for s in by_screening[count:] if sensitivity(s) > VISIBLE]
+    rest = [s for s in by_screening if s not in chosen and sensitivity(s) > VISIBLE]
     reaching = [s for s in rest if sensitivity(s) >= excess]
     extra = min(reaching, key=sensitivity) if reaching else max(rest, key=sensitivity, default=None)
     return chosen + ([extra] if extra is not None and excess > 0.0 else [])
 
 
+def low_band_best(scored: Scored) -> float:
+    """The lowest χ² of the candidate's runs in the screening band."""
+    return min((p.low_band_chi_square for p in scored.points), default=np.inf)
+
+
 def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
-    """Scan, then zoom twice around each candidate's best point, or for a rough one two rounds about its
-    smoothed minimum (each round one parallel batch for all candidates)."""
+    """Scan, then the screening band's valley and two zooms around each candidate's best points, or for a rough
+    one two rounds about its smoothed minimum (each round one parallel batch for all candidates)."""
     evaluate_points(evaluator, record, sensors, [(s, v) for s in chosen for v in s.candidate.grid(SCAN_POINTS)], document)
     smooth = [s for s in chosen if not s.candidate.rough]
     rough = [s for s in chosen if s.candidate.rough]
     for s in rough:
         s.window = (float(s.candidate.to_unit(s.best.value)), 1.0 / (SCAN_POINTS + 1))
+    evaluate_points(evaluator, record, sensors, [(s, v) for s in smooth for v in low_band_values(s)], document)
     for round_ in range(max(len(ZOOM_ROUNDS), ROUGH_ROUNDS)):
         jobs = [(s, v) for s in smooth if round_ < len(ZOOM_ROUNDS) for v in _zoom(s, ZOOM_ROUNDS[round_])]
         jobs += [(s, v) for s in rough if round_ < ROUGH_ROUNDS for v in _window_values(s)]
@@ -231,16 +251,19 @@ def _smoothed_minimum(scored: Scored, centre: float, half: float) -> tuple[float
     return float(units[lowest]), half
 
 
-def profile_vertex(scored: Scored) -> float | None:
-    """Vertex of a parabola fitted (least squares) to χ² over the points near the best one, in the
-    candidate's unit range: the minimum of the profile with the chaotic scatter of single runs
-    smoothed out. None when the local profile is not convex or the vertex leaves the points' span."""
+def profile_vertex(scored: Scored, low_band: bool = False) -> float | None:
+    """Vertex of a parabola fitted (least squares) to χ² (of the comparison band, or of the screening band)
+    over the points near the best one, in the candidate's unit range: the minimum of the profile with the
+    chaotic scatter of single runs smoothed out. None when the local profile is not convex or the vertex
+    leaves the points' span."""
     points = [p for p in scored.points if p.fit is not None]
     if len(points) < 4:
         return None
     units = scored.candidate.to_unit([p.value for p in points])
-    chi = np.array([p.chi_square for p in points])
-    centre = float(scored.candidate.to_unit(scored.best.value))
+    chi = np.array([p.low_band_chi_square if low_band else p.chi_square for p in points])
+    if not np.all(np.isfinite(chi)):
+        return None
+    centre = float(units[np.argmin(chi)])
     near = np.argsort(np.abs(units - centre))[:PROFILE_POINTS]
     if np.ptp(units[near]) <= 0.0:
         return None
@@ -251,6 +274,18 @@ def profile_vertex(scored: Scored) -> float | None:
     if not units[near].min() <= vertex <= units[near].max():
         return None
     return float(scored.candidate.from_unit(vertex))
+
+
+def low_band_values(scored: Scored) -> list[float]:
+    """Values about the minimum of the candidate's profile in the screening band (its vertex and ± a quarter
+    of a scan step): where the valley of the comparison band lies when the scan missed it."""
+    vertex = profile_vertex(scored, low_band=True)
+    if vertex is None:
+        return []
+    centre, quarter = float(scored.candidate.to_unit(vertex)), 0.25 / (SCAN_POINTS + 1)
+    known = {p.value for p in scored.points}
+    values = [float(scored.candidate.from_unit(u)) for u in (centre - quarter, centre, centre + quarter) if 0.0 <= u <= 1.0]
+    return [v for v in values if v not in known]
 
 
 def _zoom(scored: Scored, count: int) -> list[float]:

@@ -246,7 +246,7 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds, Path(request.config).parent) if c.key not in found_keys]
     scored = screen(evaluator, record, sensors, candidates, document, base_point)
     visible = [s for s in scored if seen_by_sensors(s, baseline.chi_square)]
-    chosen = to_fit(visible, baseline, record, request.fit_top)
+    chosen = to_fit(visible, base_point, record, request.fit_top)
     say(f"  screened {len(candidates)} candidates ({len(visible)} visible to the sensors); fitting "
         + ", ".join(s.candidate.label for s in chosen))
     refine(evaluator, record, sensors, chosen, document)

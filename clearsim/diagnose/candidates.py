@@ -44,6 +44,7 @@ class Candidate:
     display_unit: tuple[str, float] = ("", 1.0)  # unit shown to engineers and the SI value of one of it
     resonant: bool = False  # the parameter is a stiffness setting a resonance, frequency ∝ √value (search.resonance_seeds)
     rough: bool = False  # its cost is a comb of narrow minima: fitted on the smoothed profile (search.rough_rounds)
+    pin_radius: float | None = None  # friction of an ideal pin: the journal radius its torque μ F R_J uses (m)
 
     @property
     def key(self) -> tuple[str, str | None, str]:
@@ -52,7 +53,8 @@ class Candidate:
     @property
     def label(self) -> str:
         where = f" in joint {self.target}" if self.kind in JOINT_KINDS else (f" of {self.target}" if self.target else "")
-        return f"{KIND_TITLES.get(self.kind, self.kind)}{where}" + (f" ({self.parameter})" if self.kind == "drive" else "")
+        pin = f" (pin, R = {self.pin_radius * 1e3:.3g} mm)" if self.pin_radius is not None else ""
+        return f"{KIND_TITLES.get(self.kind, self.kind)}{where}{pin}" + (f" ({self.parameter})" if self.kind == "drive" else "")
 
     def applied(self, document: dict, value: float) -> dict:
         """A copy of the document with the parameter set to `value`."""
@@ -137,26 +139,41 @@ def clearance(mechanism, document) -> list[Candidate]:
 
 
 FRICTION_BOUNDS = (0.0, 0.5)
+PIN_CLEARANCE = 5e-6  # m: an ideal pin given friction becomes a journal in its bearing with this tight fit (2 µm: 7× the steps)
 
 
 def friction(mechanism, document) -> list[Candidate]:
-    """Dynamic friction coefficient μ_d of each clearance joint (μ_s keeps its ratio to μ_d). Rough: friction
-    reaches kinematic sensors through the chaotic journal motion, so χ² over μ_d is a comb of narrow minima
-    (slider-crank: teeth ~0.004 wide in μ_d) over a smooth basin."""
+    """Dynamic friction coefficient μ_d of each revolute joint (μ_s keeps its ratio to μ_d). A clearance joint's
+    own friction; an ideal pin becomes what it physically is, a journal in a bearing with a tight fit
+    (PIN_CLEARANCE) pressed on the wall by the joint's load, whose friction torque is μ_d F_n R_J (the
+    friction circle), with the file's default friction law. Rough: friction reaches kinematic sensors through
+    the chaotic journal motion, so χ² over μ_d is a comb of narrow minima (slider-crank: teeth ~0.004 wide in
+    μ_d) over a smooth basin."""
+    needs_radius = mechanism.defaults.bearing_radius is None
     out = []
-    for joint in _clearance_joints(mechanism):
-        p = resolve_clearance(joint, mechanism.defaults)
+    for joint in _revolute(mechanism):
+        pin = not is_clearance_joint(joint)
+        radius_missing = pin and needs_radius and joint.bearing_radius is None and joint.journal_radius is None
+        as_journal = joint.model_copy(update={"clearance": PIN_CLEARANCE, "journal_radius": None,
+                                              **({"bearing_radius": DEFAULT_BEARING_RADIUS} if radius_missing else {})})
+        p = resolve_clearance(as_journal if pin else joint, mechanism.defaults)
         law = p.friction_law if p.friction_law != "none" else "coulomb"
         ratio = p.mu_s / p.mu_d if p.friction_law == "stiction_step" and p.mu_d > 0 else 1.0
         spec = {"stiction_step": {"v_s": p.v_low, "v_d": p.v_high}, "ambrosio": {"v_0": p.v_low, "v_1": p.v_high}}
 
-        def write(doc, value, name=joint.name, law=law, ratio=ratio, extra=spec.get(law, {})):
+        def write(doc, value, name=joint.name, law=law, ratio=ratio, extra=spec.get(law, {}), pin=pin,
+                  add_radius=radius_missing):
+            if add_radius:
+                _set(doc, f"joints.{name}.bearing_radius", DEFAULT_BEARING_RADIUS)
+            if pin:
+                _set(doc, f"joints.{name}.clearance", PIN_CLEARANCE)
             numbers = {"mu_d": value, **({"mu_s": value * ratio} if law == "stiction_step" else {}), **extra}
             body = ", ".join(f"{k}: {v!r}" for k, v in numbers.items())
             _set(doc, f"joints.{name}.friction", f"{{law: {law}, {body}}}")
 
-        current = p.mu_d if p.friction_law != "none" else None
-        out.append(Candidate("friction", joint.name, "mu_d", "", *FRICTION_BOUNDS, False, current, write, rough=True))
+        current = None if pin or p.friction_law == "none" else p.mu_d
+        out.append(Candidate("friction", joint.name, "mu_d", "", *FRICTION_BOUNDS, False, current, write, rough=True,
+                             pin_radius=p.journal_radius if pin else None))
     return out
 
 

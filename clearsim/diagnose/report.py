@@ -12,7 +12,7 @@ import numpy as np
 
 from clearsim.diagnose.align import predict, residuals
 from clearsim.diagnose.evaluate import document_text
-from clearsim.diagnose.search import JointFit, Scored
+from clearsim.diagnose.search import JointFit, Scored, smoothed_interval
 from clearsim.diagnose.workflow import Diagnosis, Effect, effect_line, found_effect, refit_line
 from clearsim.io.hdf5 import keep_existing
 
@@ -50,9 +50,19 @@ def _ranking(scored: list[Scored]) -> list[dict]:
                      "delta_bic": s.delta_bic if np.isfinite(s.delta_bic) else None,
                      "gap": best.fit.gap if best else None, "runs": len(s.points),
                      "failed_runs": sum(p.fit is None for p in s.points),
-                     "profile": [[p.value, p.chi_square if p.fit is not None else None]
-                                 for p in sorted(s.points, key=lambda p: p.value)]})
+                     "profile": [[p.value, p.chi_square if p.fit is not None else None,
+                                  p.low_band_chi_square if p.low_band is not None else None]
+                                 for p in sorted(s.points, key=lambda p: p.value)],
+                     "smoothed_in": (None if s.smoothed is None
+                                     else "screening band" if s.smoothed_in_low_band else "comparison band"),
+                     "smoothed": {("screening band" if band else "comparison band"): _smoothed_value(s, profile)
+                                  for band, profile in s.profiles.items()}})
     return rows
+
+
+def _smoothed_value(scored: Scored, profile: tuple[float, float]) -> dict:
+    """A rough candidate's smoothed minimum in one band, as an SI value with its interval."""
+    return {"value": float(scored.candidate.from_unit(profile[0])), "interval": list(smoothed_interval(scored, profile))}
 
 
 def diagnosis_document(d: Diagnosis) -> dict:

@@ -19,7 +19,8 @@ around its best point, never a gradient method:
 A rough candidate (friction: its cost is a comb of narrow minima, the teeth far narrower than any
 affordable grid step) is not zoomed: after the scan, two rounds of evenly spread values in a window
 about the smoothed minimum (a least-squares parabola through every run in the window), the window
-halved each round, then one run at the last parabola's vertex. That run is the estimate (not the
+halved each round, in both bands (a window each), then one run at the last parabola's vertex of the band
+where it is better determined (smaller uncertainty). That run is the estimate (not the
 lowest run, which is whichever tooth the grid happened to hit), its interval the vertex ± its
 uncertainty (standard error and the width the comb's scatter leaves).
 
@@ -90,8 +91,11 @@ class Scored:
     ambiguous_with: list[str] = field(default_factory=list)
     telling_sensor: str | None = None
     halves: tuple[float, float] | None = None  # Δχ² on the first and second half of the record
-    window: tuple[float, float] | None = None  # rough candidate: centre and half-width (unit range) of its window
-    smoothed: tuple[float, float] | None = None  # rough candidate: vertex of the smoothed profile and its std. error
+    windows: dict[bool, tuple[float, float]] = field(default_factory=dict)  # rough: per band (low_band?), centre
+    # and half-width (unit range) of its window
+    profiles: dict[bool, tuple[float, float]] = field(default_factory=dict)  # rough: per band, smoothed vertex, error
+    smoothed: tuple[float, float] | None = None  # rough candidate: the better-determined band's vertex and error
+    smoothed_in_low_band: bool = False  # that band is the screening band
 
     @property
     def best(self) -> Point | None:
@@ -191,6 +195,15 @@ def to_fit(screened: list[Scored], baseline: Point, record: Record, count: int) 
     return chosen + ([extra] if extra is not None and excess > 0.0 else [])
 
 
+BANDS = (False, True)  # a rough candidate's profile is smoothed in the comparison band and in the screening band
+
+
+def lowest(scored: Scored, low_band: bool) -> Point:
+    """The run with the lowest χ² in the comparison band, or in the screening band."""
+    return min((p for p in scored.points if p.fit is not None),
+               key=lambda p: p.low_band_chi_square if low_band else p.chi_square)
+
+
 def low_band_best(scored: Scored) -> float:
     """The lowest χ² of the candidate's runs in the screening band."""
     return min((p.low_band_chi_square for p in scored.points), default=np.inf)
@@ -203,16 +216,18 @@ def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
     smooth = [s for s in chosen if not s.candidate.rough]
     rough = [s for s in chosen if s.candidate.rough]
     for s in rough:
-        s.window = (float(s.candidate.to_unit(s.best.value)), 1.0 / (SCAN_POINTS + 1))
+        s.windows = {band: (float(s.candidate.to_unit(lowest(s, band).value)), 1.0 / (SCAN_POINTS + 1)) for band in BANDS}
     evaluate_points(evaluator, record, sensors, [(s, v) for s in smooth for v in low_band_values(s)], document)
     for round_ in range(max(len(ZOOM_ROUNDS), ROUGH_ROUNDS)):
         jobs = [(s, v) for s in smooth if round_ < len(ZOOM_ROUNDS) for v in _zoom(s, ZOOM_ROUNDS[round_])]
         jobs += [(s, v) for s in rough if round_ < ROUGH_ROUNDS for v in _window_values(s)]
         evaluate_points(evaluator, record, sensors, jobs, document)
         for s in rough if round_ < ROUGH_ROUNDS else []:
-            centre, half = s.window
-            s.smoothed = _smoothed_minimum(s, centre, half)
-            s.window = (s.smoothed[0], half / 2.0)
+            s.profiles = {band: _smoothed_minimum(s, *s.windows[band], band) for band in BANDS}
+            s.windows = {band: (s.profiles[band][0], s.windows[band][1] / 2.0) for band in BANDS}
+    for s in rough:
+        s.smoothed_in_low_band = min(BANDS, key=lambda band: s.profiles[band][1])
+        s.smoothed = s.profiles[s.smoothed_in_low_band]
     jobs = [(s, v) for s in smooth if (v := profile_vertex(s)) is not None]
     jobs += [(s, float(s.candidate.from_unit(s.smoothed[0]))) for s in rough]
     evaluate_points(evaluator, record, sensors, jobs, document)
@@ -221,22 +236,24 @@ def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
 
 
 def _window_values(scored: Scored) -> list[float]:
-    """ROUGH_POINTS values evenly spread inside the rough candidate's window (ends excluded), within the bounds."""
-    centre, half = scored.window
-    units = centre + half * np.linspace(-1.0, 1.0, ROUGH_POINTS + 2)[1:-1]
-    return [float(scored.candidate.from_unit(u)) for u in units if 0.0 <= u <= 1.0]
+    """ROUGH_POINTS values evenly spread inside each band's window of the rough candidate (ends excluded), within
+    the bounds, new ones only."""
+    units = [centre + half * u for centre, half in scored.windows.values() for u in np.linspace(-1.0, 1.0, ROUGH_POINTS + 2)[1:-1]]
+    known = {p.value for p in scored.points}
+    values = [float(scored.candidate.from_unit(u)) for u in units if 0.0 <= u <= 1.0]
+    return [v for v in dict.fromkeys(values) if v not in known]
 
 
-def _smoothed_minimum(scored: Scored, centre: float, half: float) -> tuple[float, float]:
-    """Minimum of the profile smoothed over [centre − half, centre + half] (unit range): the vertex of a
-    least-squares parabola a (u − v)² + c through every run in it, and its uncertainty √(σ_v² + s/a): σ_v the
-    vertex's standard error (delta method, the comb's scatter about the parabola taken as the noise), √(s/a)
-    the half-width where the parabola rises by s, the RMS of that scatter (values the comb does not tell
-    apart). When the parabola is not convex or its vertex leaves the window: the lowest run in the window,
-    with the window's half-width as the uncertainty."""
+def _smoothed_minimum(scored: Scored, centre: float, half: float, low_band: bool) -> tuple[float, float]:
+    """Minimum of the profile (χ² in the comparison band, or in the screening band) smoothed over
+    [centre − half, centre + half] (unit range): the vertex of a least-squares parabola a (u − v)² + c through
+    every run in it, and its uncertainty √(σ_v² + s/a): σ_v the vertex's standard error (delta method, the
+    comb's scatter about the parabola taken as the noise), √(s/a) the half-width where the parabola rises by s,
+    the RMS of that scatter (values the comb does not tell apart). When the parabola is not convex or its
+    vertex leaves the window: the lowest run in the window, with the window's half-width as the uncertainty."""
     points = [p for p in scored.points if p.fit is not None]
     units = scored.candidate.to_unit([p.value for p in points])
-    chi = np.array([p.chi_square for p in points])
+    chi = np.array([p.low_band_chi_square if low_band else p.chi_square for p in points])
     inside = np.abs(units - centre) <= half * (1.0 + 1e-9)
     if inside.sum() >= 6:  # polyfit's covariance needs more points than coefficients + 2
         coefficients, covariance = np.polyfit(units[inside] - centre, chi[inside], 2, cov=True)
@@ -337,9 +354,10 @@ def interval(scored: Scored, record: Record) -> tuple[float, float]:
     return float(scored.candidate.from_unit(low_u)), float(scored.candidate.from_unit(high_u))
 
 
-def smoothed_interval(scored: Scored) -> tuple[float, float]:
-    """A rough candidate's interval: the smoothed profile's vertex ± its uncertainty, within the bounds."""
-    vertex, error = scored.smoothed
+def smoothed_interval(scored: Scored, profile: tuple[float, float] | None = None) -> tuple[float, float]:
+    """A rough candidate's interval: the smoothed profile's vertex ± its uncertainty (of the band chosen, or of
+    `profile`: one band's (vertex, error)), within the bounds."""
+    vertex, error = profile or scored.smoothed
     low, high = np.clip([vertex - error, vertex + error], 0.0, 1.0)
     return float(scored.candidate.from_unit(low)), float(scored.candidate.from_unit(high))
 

@@ -9,10 +9,17 @@ the study `crank-friction` of docs/diagnose.md with two candidate kinds at the s
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
+import yaml
 from typer.testing import CliRunner
 
 from clearsim.cli import app
+from clearsim.diagnose.candidates import PIN_CLEARANCE, candidates_for
+from clearsim.diagnose.evaluate import document_text
+from clearsim.io.hdf5 import read_result
+from clearsim.model.loader import load_mechanism, load_mechanism_text
+from clearsim.runner import prepare, run_to_file
 
 CONFIG = str(Path(__file__).resolve().parents[2] / "clearsim" / "configs" / "slider_crank_flores_friction.yaml")
 BENCH = ["--sensors", "slider_displacement,slider_velocity", "--rate", "50kHz", "--lowpass", "10kHz",
@@ -35,3 +42,31 @@ def test_a_hidden_friction_change_is_named_at_its_joint_and_fitted_within_20_per
     assert (effect["kind"], effect["target"]) == ("friction", "slider_pin")
     assert effect["parameters"]["mu_d"] == pytest.approx(TRUE_MU, rel=0.2)
     assert found["gap_after"] < 0.6 * found["gap_before"]
+
+
+def test_pin_friction_candidate_makes_an_ideal_pin_dissipate_as_its_friction_circle(tmp_path):
+    """The friction candidate of an ideal pin (crank_pin) makes it a journal in a bearing with a tight fit
+    (PIN_CLEARANCE), loaded as the ideal pin was: its friction then dissipates ∫ μ R_J |F| |ω_rod − ω_crank| dt,
+    with F the ideal pin's reaction (the friction-circle model of a pin), and the slider moves as with the ideal pin."""
+    mu = 0.1
+    source = Path(CONFIG).with_name("slider_crank_flores.yaml")
+    ideal = load_mechanism(source, ["joints.slider_pin.clearance=0", "solver.t_end=12ms"])
+    document = yaml.safe_load(ideal.resolved_yaml)
+    pin = next(c for c in candidates_for(ideal.mechanism, document, ["friction"]) if c.target == "crank_pin")
+    assert pin.current is None and pin.pin_radius == pytest.approx(0.01 - PIN_CLEARANCE)
+    with_pin = load_mechanism_text(document_text(pin.applied(document, mu)), str(source), (), source.parent)
+
+    def run(loaded, name):
+        report = run_to_file(prepare(loaded), loaded, tmp_path / name)
+        assert report.complete, report.status
+        return read_result(tmp_path / name)
+
+    a, b = run(ideal, "ideal.h5"), run(with_pin, "pin.h5")
+    time = a["time"]
+    slip = np.abs(a["bodies/rod/qd"][:, 2] - a["bodies/crank/qd"][:, 2])
+    load = np.hypot(*a["joints/crank_pin/reaction"].T)
+    rate = mu * pin.pin_radius * load * slip
+    circle = float(np.sum(0.5 * (rate[1:] + rate[:-1]) * np.diff(time)))
+    assert b["energy/friction_dissipated"][-1] == pytest.approx(circle, rel=0.01)  # 22.297 J vs 22.322 J
+    stroke = np.ptp(a["sensors/slider_displacement"])
+    assert np.max(np.abs(b["sensors/slider_displacement"] - a["sensors/slider_displacement"])) < 5e-4 * stroke  # 1.5e-4: the 5 µm fit

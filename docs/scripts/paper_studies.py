@@ -54,11 +54,12 @@ SWEEPS = {
     # case 5 for the UHV model (the file's A and J at 0.01 mm): tolerance, then output rate
     "uhv_rtol": ["--set", "solver.rtol=1e-6,1e-7,1e-8,1e-9"],
     "uhv_rate": ["--set", "solver.output_rate=100kHz,1MHz"],
+    "uhv_rate_c01": ["--clearance", "0.1", "--joints", "A,J", "--set", "solver.output_rate=100kHz,1MHz"],
     # case 5 for the other clearances of case 6: the a_and_j sweep again at rtol 1e-9
     "a_and_j_rtol": ["--clearance", "0.03,0.05,0.1", "--joints", "A,J", "--set", "solver.rtol=1e-9"],
 }
 SWEPT = {"friction": "defaults.friction.mu_d", "friction_rtol": "defaults.friction.mu_d",
-         "uhv_rtol": "solver.rtol", "uhv_rate": "solver.output_rate"}
+         "uhv_rtol": "solver.rtol", "uhv_rate": "solver.output_rate", "uhv_rate_c01": "solver.output_rate"}
 DEFAULT_RTOL, TIGHT_RTOL = "1e-7", "1e-9"
 
 PAPER = {  # Meng et al. 2015, section 4 (quoted in DESIGN.md §5 / issue 7); missing: not given in the text

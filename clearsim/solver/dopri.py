@@ -56,10 +56,10 @@ def step(system, t, y, f, h, modes, speeds, stages, y_new):
     for s in range(1, 6):
         _accumulate(work, y, MATRIX[s], h, stages, s)
         rhs(system, min(t + NODES[s] * h, end), work, modes, speeds, stages[s])
-    _accumulate(y_new, y, WEIGHTS, h, stages, 6)
+    _accumulate(y_new, y, WEIGHTS, h, stages, WEIGHTS.shape[0])
     rhs(system, end, y_new, modes, speeds, stages[6])
     error = np.zeros_like(y)
-    _accumulate(error, error, ERROR_WEIGHTS, h, stages, STAGES)
+    _accumulate(error, error, ERROR_WEIGHTS, h, stages, ERROR_WEIGHTS.shape[0])
     return error
 
 

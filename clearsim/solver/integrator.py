@@ -113,12 +113,12 @@ def _value_at(system, k, kind, t, y, stages, h, theta, modes, speeds, scratch):
 
 
 @njit(cache=True)
-def _extremum(system, k, t, y, stages, h, lo, hi, modes, speeds, scratch):
-    """θ where ġ = 0 between lo and hi (ġ changes sign there), by bisection (NORMAL events)."""
-    rate_lo = _value_at(system, k, NORMAL, t, y, stages, h, lo, modes, speeds, scratch)[1]
+def _extremum(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
+    """θ where ġ = 0 between lo and hi (ġ changes sign there), by bisection (NORMAL events, which know ġ)."""
+    rate_lo = _value_at(system, k, kind, t, y, stages, h, lo, modes, speeds, scratch)[1]
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        rate = _value_at(system, k, NORMAL, t, y, stages, h, mid, modes, speeds, scratch)[1]
+        rate = _value_at(system, k, kind, t, y, stages, h, mid, modes, speeds, scratch)[1]
         if (rate > 0.0) == (rate_lo > 0.0):
             lo, rate_lo = mid, rate
         else:
@@ -172,12 +172,26 @@ def first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
             return _root(system, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
         turning = (r_prev > 0.0 and r < 0.0) if mode == FREE else (r_prev < 0.0 and r > 0.0)
         if kind == NORMAL and turning:  # a graze: δ may cross and return between the two samples
-            peak = _extremum(system, k, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
+            peak = _extremum(system, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
             g_peak = _value_at(system, k, kind, t, y, stages, h, peak, modes, speeds, scratch)[0]
             if _crossed(mode, kind, g_prev, g_peak):
                 return _root(system, k, kind, t, y, stages, h, theta_prev, peak, modes, speeds, scratch)
         g_prev, r_prev, theta_prev = g, r, theta
     return 2.0
+
+
+@njit(cache=True)
+def earliest_event(system, t, y, y_new, stages, h, modes, speeds, scratch):
+    """(θ, joint, kind) of the step's first event, or (2.0, −1, NORMAL) when there is none."""
+    event_theta = 2.0
+    event_joint = -1
+    event_kind = NORMAL
+    for k in range(modes.shape[0]):
+        for kind in range(2):
+            theta = first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
+            if theta < event_theta:
+                event_theta, event_joint, event_kind = theta, k, kind
+    return event_theta, event_joint, event_kind
 
 
 @njit(cache=True)
@@ -228,7 +242,7 @@ def contact_time_step(system, k, q, speed):
 
 
 @njit(cache=True)
-def settle_friction(system, k, t, y, modes, speeds, may_stick=True):
+def settle_friction(system, k, t, y, modes, speeds, may_stick):
     """Choose how joint k's contact carries friction at time t: slide on, or stick if the wall can hold it.
 
     Sliding faster than DECIDE_SPEED goes on in its direction. Slower (a reversal, or a new contact
@@ -258,8 +272,9 @@ def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_join
                 log_speed, log_mass):
     """Apply joint k's event at time t; returns the suggested next step."""
     n = coordinate_count(system)
+    may_stick = modes[k] != STICK  # a stick that just broke slides; a new contact or a sliding one may stick
     if kind == TANGENTIAL:
-        settle_friction(system, k, t, y, modes, speeds, modes[k] != STICK)
+        settle_friction(system, k, t, y, modes, speeds, may_stick)
         ints[I_FRICTION_EVENTS] += 1
         return np.inf
     if modes[k] != FREE:
@@ -269,7 +284,7 @@ def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_join
         return np.inf
     speed = max(clearance_kinematics(system, k, y[:n], y[n:2 * n])[5], 0.0)
     speeds[k] = speed
-    settle_friction(system, k, t, y, modes, speeds)
+    settle_friction(system, k, t, y, modes, speeds, may_stick)
     h, mass = contact_time_step(system, k, y[:n], speed)
     row = ints[I_LOG]
     log_joint[row] = k
@@ -431,14 +446,7 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             real[R_STEP] = max(h * max(0.2, SAFETY * norm ** -0.2), real[R_MIN_STEP])
             continue
         real[R_STEP] = h * min(10.0, max(0.2, SAFETY * norm ** -0.2)) if norm > 0.0 else 10.0 * h
-        event_theta = 2.0
-        event_joint = -1
-        event_kind = NORMAL
-        for k in range(modes.shape[0]):
-            for kind in range(2):
-                theta = first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
-                if theta < event_theta:
-                    event_theta, event_joint, event_kind = theta, k, kind
+        event_theta, event_joint, event_kind = earliest_event(system, t, y, y_new, stages, h, modes, speeds, scratch)
         if event_joint >= 0:
             h = refine_event(system, event_joint, event_kind, t, y, f, event_theta * h, modes, speeds, stages,
                              y_new, ints)

@@ -45,7 +45,7 @@ def _accumulate(out, base, coefficients, h, stages, count):
                 out[i] += weight * stages[j, i]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step(system, t, y, f, h, modes, speeds, stages, y_new):
     """One DOPRI5 step from (t, y) with ẏ(t) = f; fills stages (7, ny) and y_new; returns the error vector."""
     stages[0, :] = f

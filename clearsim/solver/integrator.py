@@ -15,6 +15,12 @@ projected onto the constraints like every step end.
 
 The loop runs until t_stop, a full sample buffer or a failure, then returns to Python (progress
 bar, writing, Ctrl-C); all its state lives in the arrays of `IntegratorState`.
+
+Compile time (docs/performance.md): numba compiles every kernel it calls as a library of its own,
+with all its callees linked in and optimised again. The parts of the loop called at one or two
+places (events, mode switches, sampling, the step) are therefore inlined into `advance`
+(inline="always"), and so are the scalar helpers; kernels called many times per step that take
+`system` stay calls, since an inlined copy takes and releases a reference to each of its arrays.
 """
 
 from __future__ import annotations
@@ -99,7 +105,7 @@ def event_value(system, k, kind, t, y, modes, speeds):
     return direction * clearance_kinematics(system, k, y[:n], y[n:2 * n])[8] + SLIDE_HYSTERESIS, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _crossed(mode, kind, before, after):
     if kind == NORMAL and mode == FREE:
         return before < 0.0 and after >= 0.0
@@ -112,7 +118,7 @@ def _value_at(system, k, kind, t, y, stages, h, theta, modes, speeds, scratch):
     return event_value(system, k, kind, t + theta * h, scratch, modes, speeds)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _extremum(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
     """θ where ġ = 0 between lo and hi (ġ changes sign there), by bisection (NORMAL events, which know ġ)."""
     rate_lo = _value_at(system, k, kind, t, y, stages, h, lo, modes, speeds, scratch)[1]
@@ -128,7 +134,7 @@ def _extremum(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
     return 0.5 * (lo + hi)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _root(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
     """θ just past the crossing of g in [lo, hi] (Illinois false position on the dense output)."""
     mode = modes[k]
@@ -154,7 +160,7 @@ def _root(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
     return hi
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch):
     """θ in (0, 1] of joint k's first event of this kind in the step, or 2.0 when there is none."""
     mode = modes[k]
@@ -180,12 +186,12 @@ def first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
     return 2.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def earliest_event(system, t, y, y_new, stages, h, modes, speeds, scratch):
     """(θ, joint, kind) of the step's first event, or (2.0, −1, NORMAL) when there is none."""
     event_theta = 2.0
-    event_joint = -1
-    event_kind = NORMAL
+    event_joint = np.int64(-1)  # int64 from the start: a literal would compile each callee once more for it
+    event_kind = np.int64(NORMAL)
     for k in range(modes.shape[0]):
         for kind in range(2):
             theta = first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
@@ -203,7 +209,7 @@ def project_state(system, t, y, modes):
     return violation
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints,
                  out_t, out_y, out_modes, out_speeds, out_episode, scratch):
     """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected."""
@@ -227,7 +233,7 @@ def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, rea
         ints[I_NEXT_SAMPLE] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def contact_time_step(system, k, q, speed):
     """Initial step into contact: the Hertz contact time t_c = 3.218 (m/K)^(2/5) v^(−1/5), over 20."""
     mass = effective_mass(system, k, q)
@@ -241,7 +247,7 @@ def contact_time_step(system, k, q, speed):
     return t_c / 20.0, mass
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def settle_friction(system, k, t, y, modes, speeds, may_stick):
     """Choose how joint k's contact carries friction at time t: slide on, or stick if the wall can hold it.
 
@@ -267,24 +273,25 @@ def settle_friction(system, k, t, y, modes, speeds, may_stick):
         project_state(system, t, y, modes)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_joint, log_onset, log_loss,
                 log_speed, log_mass):
     """Apply joint k's event at time t; returns the suggested next step."""
-    n = coordinate_count(system)
-    may_stick = modes[k] != STICK  # a stick that just broke slides; a new contact or a sliding one may stick
-    if kind == TANGENTIAL:
-        settle_friction(system, k, t, y, modes, speeds, may_stick)
-        ints[I_FRICTION_EVENTS] += 1
-        return np.inf
-    if modes[k] != FREE:
+    if kind == NORMAL and modes[k] != FREE:  # contact lost
         modes[k] = FREE
         log_loss[episode_of[k]] = t
         episode_of[k] = -1
         return np.inf
-    speed = max(clearance_kinematics(system, k, y[:n], y[n:2 * n])[5], 0.0)
-    speeds[k] = speed
-    settle_friction(system, k, t, y, modes, speeds, may_stick)
+    onset = kind == NORMAL
+    n = coordinate_count(system)
+    if onset:
+        speeds[k] = max(clearance_kinematics(system, k, y[:n], y[n:2 * n])[5], 0.0)
+    # a stick that just broke slides; a new contact or a sliding one may stick
+    settle_friction(system, k, t, y, modes, speeds, modes[k] != STICK)
+    if not onset:
+        ints[I_FRICTION_EVENTS] += 1
+        return np.inf
+    speed = speeds[k]
     h, mass = contact_time_step(system, k, y[:n], speed)
     row = ints[I_LOG]
     log_joint[row] = k
@@ -298,7 +305,7 @@ def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_join
     return h
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def consistent_modes(system, t, y, modes, speeds, episode_of, ints, log_joint, log_onset, log_loss,
                      log_speed, log_mass):
     """Switch joints whose mode disagrees with the state at the step start (initial state, restarts)."""
@@ -314,7 +321,7 @@ def consistent_modes(system, t, y, modes, speeds, episode_of, ints, log_joint, l
     return h
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def free_flight_limit(system, y, modes):
     """Longest step that keeps every free journal from crossing its clearance c."""
     n = coordinate_count(system)
@@ -337,7 +344,7 @@ def normal_force_at(system, k, y, stages, h, theta, modes, speeds, scratch):
     return contact_force_magnitudes(system, k, kin[4], kin[5], kin[8], modes[k], speeds[k])[0]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
     """Raise peak_force[k] to the largest F_n of the step: at 4 points, then at an interior maximum.
 
@@ -375,7 +382,7 @@ def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
         peak_force[k] = max(peak_force[k], best, fa, fb)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def refine_event(system, k, kind, t, y, f, h_event, modes, speeds, stages, y_event, ints):
     """Integrate from t exactly to joint k's event; returns the step length.
 

@@ -40,6 +40,7 @@ from clearsim.assembly.forces import (
 )
 from clearsim.physics.friction import static_coefficient
 from clearsim.solver.dopri import STAGES, error_norm, interpolate, step
+from clearsim.solver.samples import derive_sample
 
 # real_state slots
 R_TIME, R_STEP, R_T_END, R_RTOL, R_ATOL, R_MAX_STEP, R_MIN_STEP, R_SAMPLE_DT, R_VIOLATION = range(9)
@@ -211,8 +212,8 @@ def project_state(system, t, y, modes):
 
 @njit(cache=True, inline="always")
 def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints,
-                 out_t, out_y, out_modes, out_speeds, out_episode, scratch):
-    """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected."""
+                 out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch):
+    """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives from them."""
     dt = real[R_SAMPLE_DT]
     while ints[I_NEXT_SAMPLE] < ints[I_TOTAL_SAMPLES]:
         sample_time = min(ints[I_NEXT_SAMPLE] * dt, real[R_T_END])
@@ -229,6 +230,8 @@ def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, rea
         out_modes[row, :] = modes
         out_speeds[row, :] = speeds
         out_episode[row, :] = episode_of
+        derive_sample(system, sample_time, scratch, modes, speeds, out_qdd[row], out_lam[row], out_contact[row],
+                      out_energies[row])
         ints[I_SAMPLES] += 1
         ints[I_NEXT_SAMPLE] += 1
 
@@ -405,7 +408,8 @@ def refine_event(system, k, kind, t, y, f, h_event, modes, speeds, stages, y_eve
 
 @njit(cache=True)
 def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_onset, log_loss,
-            log_speed, log_mass, peak_force, out_t, out_y, out_modes, out_speeds, out_episode, t_stop):
+            log_speed, log_mass, peak_force, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam,
+            out_contact, out_energies, t_stop):
     """Integrate until t_stop, the end, a full buffer or a failure; the status is ints[I_STATUS]."""
     n = coordinate_count(system)
     stages = np.empty((STAGES, y.shape[0]))
@@ -432,7 +436,8 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             real[R_STEP] = min(real[R_STEP], switched)
         if ints[I_NEXT_SAMPLE] == 0:  # the first sample, in the modes the initial state has
             emit_samples(system, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints,
-                         out_t, out_y, out_modes, out_speeds, out_episode, scratch)
+                         out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
+                     scratch)
         h = min(real[R_STEP], real[R_MAX_STEP], real[R_T_END] - t, free_flight_limit(system, y, modes))
         h = max(h, real[R_MIN_STEP])
         if capacity - ints[I_SAMPLES] < h / real[R_SAMPLE_DT] + 2.0:
@@ -464,7 +469,8 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
                 ints[I_STATUS] = DRIFT
                 return
         emit_samples(system, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints,
-                     out_t, out_y, out_modes, out_speeds, out_episode, scratch)
+                     out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
+                     scratch)
         update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch)
         y[:] = y_new
         real[R_TIME] = t + h if h < real[R_T_END] - t else real[R_T_END]

@@ -49,7 +49,8 @@ R_TIME, R_STEP, R_T_END, R_RTOL, R_ATOL, R_MAX_STEP, R_MIN_STEP, R_SAMPLE_DT, R_
  I_FRICTION_EVENTS, I_STALLED) = range(12)
 INT_SLOTS = 12
 
-RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END, CHATTER = range(9)
+RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END, CHATTER, FIRST_STEP = range(10)
+# FIRST_STEP: real[R_STEP] was 0 (no first step chosen), ẏ at the start is in f: choose it, call again
 STALLED_STEPS = 2000  # consecutive accepted steps shorter than min_step: the events no longer advance the time
 
 SUBDIVISIONS = 4  # points per step at which the event functions are sampled
@@ -417,6 +418,10 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
     scratch = np.empty_like(y)
     ints[I_STATUS] = RUNNING
     capacity = out_t.shape[0]
+    if real[R_STEP] <= 0.0:
+        rhs(system, real[R_TIME], y, modes, speeds, f)
+        ints[I_STATUS] = FIRST_STEP
+        return
     while True:
         t = real[R_TIME]
         if t >= real[R_T_END]:

@@ -15,7 +15,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints
-from clearsim.assembly.dynamics import WORK_COUNT, rhs
+from clearsim.assembly.dynamics import WORK_COUNT
 from clearsim.assembly.forces import FREE
 from clearsim.assembly.system import System
 from clearsim.errors import SolverError
@@ -106,8 +106,9 @@ class Run:
                         np.zeros((SAMPLE_BUFFER, nc), np.int64), np.zeros((SAMPLE_BUFFER, n)),
                         np.zeros((SAMPLE_BUFFER, constraint_count(arrays))),
                         np.zeros((SAMPLE_BUFFER, nc, CONTACT_FIELDS)), np.zeros((SAMPLE_BUFFER, ENERGY_FIELDS)))
-        rhs(arrays, 0.0, self.y, self.modes, self.speeds, self.f)
-        self.real[ig.R_STEP] = _initial_step(system, self.y, self.f)
+        # no first step yet: the loop's first call returns FIRST_STEP with ẏ(0) in f and _initial_step chooses it
+        # here (numpy's sums, as always: the step, and so every result, stays bitwise the same); calling the
+        # compiled rhs from Python instead would load a second copy of the dynamics (docs/performance.md)
         self.wall_time = 0.0
         self.coordinate_count = n
 
@@ -153,6 +154,9 @@ class Run:
         while True:
             self._advance(next_stop)
             status = int(self.ints[ig.I_STATUS])
+            if status == ig.FIRST_STEP:
+                self.real[ig.R_STEP] = _initial_step(self.system, self.y, self.f)
+                continue
             if status == ig.BUFFER_FULL and self.ints[ig.I_LOG] >= self.log[0].size - len(self.modes) - 1:
                 self._grow_log()
             chunk = self._take_samples()

@@ -212,9 +212,10 @@ def project_state(system, t, y, modes):
 
 
 @njit(cache=True, inline="always")
-def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints,
-                 out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch):
-    """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives from them."""
+def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
+                 out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch):
+    """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives
+    from them (derive_sample)."""
     dt = real[R_SAMPLE_DT]
     while ints[I_NEXT_SAMPLE] < ints[I_TOTAL_SAMPLES]:
         sample_time = min(ints[I_NEXT_SAMPLE] * dt, real[R_T_END])
@@ -440,9 +441,8 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             ints[I_RHS] += 1
             real[R_STEP] = min(real[R_STEP], switched)
         if ints[I_NEXT_SAMPLE] == 0:  # the first sample, in the modes the initial state has
-            emit_samples(system, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints,
-                         out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
-                     scratch)
+            emit_samples(system, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
+                         out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
         h = min(real[R_STEP], real[R_MAX_STEP], real[R_T_END] - t, free_flight_limit(system, y, modes))
         h = max(h, real[R_MIN_STEP])
         if capacity - ints[I_SAMPLES] < h / real[R_SAMPLE_DT] + 2.0:
@@ -473,9 +473,8 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             if violation > DRIFT_LIMIT:
                 ints[I_STATUS] = DRIFT
                 return
-        emit_samples(system, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints,
-                     out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
-                     scratch)
+        emit_samples(system, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
+                     out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
         update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch)
         y[:] = y_new
         real[R_TIME] = t + h if h < real[R_T_END] - t else real[R_T_END]

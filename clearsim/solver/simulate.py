@@ -20,7 +20,7 @@ from clearsim.assembly.forces import FREE
 from clearsim.assembly.system import System
 from clearsim.errors import SolverError
 from clearsim.solver import integrator as ig
-from clearsim.solver.samples import CONTACT_FIELDS, E_KINETIC, E_POTENTIAL, E_VIOLATION, ENERGY_FIELDS
+from clearsim.solver.samples import CONTACT_FIELDS, ENERGY_FIELDS, E_KINETIC, E_POTENTIAL, E_VIOLATION
 
 SAMPLE_BUFFER = 2048
 LOG_CAPACITY = 4096

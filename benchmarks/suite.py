@@ -108,12 +108,11 @@ def clearsim_first_impact(config: Path, t_end: float) -> tuple[float, float]:
 
 
 def profile_split(case: Case, quick: bool, folder: Path) -> dict:
-    """Where one run's wall time goes: integration (compiled loop), output sampling (derived outputs of
-    each sample), HDF5 writing, and the rest (load, assemble, episodes): timers wrapped around the
+    """Where one run's wall time goes: integration (the compiled loop, which also derives accelerations,
+    forces and energies of each sample), output sampling (the outputs by name of each chunk), HDF5 writing, and the rest (load, assemble, episodes): timers wrapped around the
     functions that do each, for one extra run."""
     from clearsim import runner
     from clearsim.io import hdf5
-    from clearsim.solver import simulate
 
     spent = {"sampling": 0.0, "hdf5": 0.0}
 
@@ -129,7 +128,7 @@ def profile_split(case: Case, quick: bool, folder: Path) -> dict:
         setattr(owner, name, wrapper)
         return owner, name, original
 
-    patches = [timed(simulate, "evaluate_samples", "sampling"), timed(runner, "chunk_outputs", "sampling"),
+    patches = [timed(runner, "chunk_outputs", "sampling"),
                timed(runner, "sample_modes", "sampling"), timed(runner, "classify_episodes", "sampling"),
                timed(hdf5.ResultWriter, "__init__", "hdf5"), timed(hdf5.ResultWriter, "__exit__", "hdf5"),
                timed(hdf5.ResultWriter, "append", "hdf5"),

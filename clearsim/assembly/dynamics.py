@@ -201,7 +201,7 @@ def rhs(system, t, y, modes, impact_speeds, ydot):
     ydot[2 * n + WORK_APPLIED] = applied
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def project_positions(system, t, q, tolerance, max_iterations):
     """Newton projection of q onto Φ(q, t) = 0 in the M metric; returns the final max |Φ|."""
     m = constraint_count(system)
@@ -220,7 +220,7 @@ def project_positions(system, t, q, tolerance, max_iterations):
     return np.max(np.abs(phi))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def project_velocities(system, t, q, qd, modes):
     """q̇ ← q̇ − M⁻¹Φ_qᵀ S⁻¹ (Φ_q q̇ − ν): the nearest consistent velocity in the M metric (stick rows: ν = 0)."""
     m = constraint_count(system) + stick_count(modes)
@@ -243,7 +243,7 @@ def constraint_violation(system, t, q):
     return np.max(np.abs(phi))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def effective_mass(system, k, q):
     """m_eff of clearance joint k along n: 1/(wᵀ P w), P the constrained mobility, w the unit force pair."""
     n = q.shape[0]

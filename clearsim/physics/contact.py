@@ -33,7 +33,7 @@ CONTACT_LAWS = {
 _HERTZ_HALF_TIME_INTEGRAL = 0.4 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)  # B(a, b) = Γ(a)Γ(b)/Γ(a + b)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def hysteresis_factor(law, restitution):
     """D(c_e): 0 (Hertz), 3(1−c_e²)/4 (Lankarani–Nikravesh 1990, Meng 2015 eq. 11),
     3(1−c_e)/2 (Hunt–Crossley 1975), 8(1−c_e)/(5c_e) (Flores et al. 2011)."""
@@ -56,7 +56,7 @@ def normal_force(law, penetration, penetration_rate, impact_speed, stiffness, ex
     return max(0.0, stiffness * penetration**exponent * (1.0 + damping))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def elastic_force(penetration, stiffness, exponent):
     """Elastic part of the contact force, K δⁿ for δ > 0, else 0 (Meng 2015 eq. 8)."""
     if penetration <= 0.0:
@@ -64,7 +64,7 @@ def elastic_force(penetration, stiffness, exponent):
     return stiffness * penetration**exponent
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def elastic_energy(penetration, stiffness, exponent):
     """Contact potential energy ∫₀^δ K sⁿ ds = K δⁿ⁺¹/(n+1) for δ > 0, else 0."""
     if penetration <= 0.0:

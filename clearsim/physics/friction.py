@@ -29,7 +29,7 @@ STICK_EXACT = 1
 STICK_TREATMENTS = {"smooth": STICK_SMOOTH, "exact": STICK_EXACT}
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _sign(value):
     if value > 0.0:
         return 1.0
@@ -38,7 +38,7 @@ def _sign(value):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_blend(x, x0, h0, x1, h1):
     """Adams STEP, h0 + (h1 − h0) Δ²(3 − 2Δ) with Δ = (x − x0)/(x1 − x0), held outside [x0, x1]."""
     if x <= x0:
@@ -97,7 +97,7 @@ def sliding_coefficient(law, speed, mu_s, mu_d, v_low, v_high):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def static_coefficient(law, mu_s, mu_d):
     """Largest |F_t|/F_n a sticking contact holds: μ_s (stiction_step), μ_d (coulomb), 0 otherwise."""
     if law == STICTION_STEP:

@@ -15,6 +15,12 @@ projected onto the constraints like every step end.
 
 The loop runs until t_stop, a full sample buffer or a failure, then returns to Python (progress
 bar, writing, Ctrl-C); all its state lives in the arrays of `IntegratorState`.
+
+Compile time (docs/performance.md): numba compiles every kernel it calls as a library of its own,
+with all its callees linked in and optimised again. The parts of the loop called at one or two
+places (events, mode switches, sampling, the step) are therefore inlined into `advance`
+(inline="always"), and so are the scalar helpers; kernels called many times per step that take
+`system` stay calls, since an inlined copy takes and releases a reference to each of its arrays.
 """
 
 from __future__ import annotations
@@ -34,6 +40,7 @@ from clearsim.assembly.forces import (
 )
 from clearsim.physics.friction import static_coefficient
 from clearsim.solver.dopri import STAGES, error_norm, interpolate, step
+from clearsim.solver.samples import derive_sample
 
 # real_state slots
 R_TIME, R_STEP, R_T_END, R_RTOL, R_ATOL, R_MAX_STEP, R_MIN_STEP, R_SAMPLE_DT, R_VIOLATION = range(9)
@@ -42,7 +49,8 @@ R_TIME, R_STEP, R_T_END, R_RTOL, R_ATOL, R_MAX_STEP, R_MIN_STEP, R_SAMPLE_DT, R_
  I_FRICTION_EVENTS, I_STALLED) = range(12)
 INT_SLOTS = 12
 
-RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END, CHATTER = range(9)
+RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END, CHATTER, FIRST_STEP = range(10)
+# FIRST_STEP: real[R_STEP] was 0 (no first step chosen), ẏ at the start is in f: choose it, call again
 STALLED_STEPS = 2000  # consecutive accepted steps shorter than min_step: the events no longer advance the time
 
 SUBDIVISIONS = 4  # points per step at which the event functions are sampled
@@ -99,7 +107,7 @@ def event_value(system, k, kind, t, y, modes, speeds):
     return direction * clearance_kinematics(system, k, y[:n], y[n:2 * n])[8] + SLIDE_HYSTERESIS, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _crossed(mode, kind, before, after):
     if kind == NORMAL and mode == FREE:
         return before < 0.0 and after >= 0.0
@@ -112,13 +120,13 @@ def _value_at(system, k, kind, t, y, stages, h, theta, modes, speeds, scratch):
     return event_value(system, k, kind, t + theta * h, scratch, modes, speeds)
 
 
-@njit(cache=True)
-def _extremum(system, k, t, y, stages, h, lo, hi, modes, speeds, scratch):
-    """θ where ġ = 0 between lo and hi (ġ changes sign there), by bisection (NORMAL events)."""
-    rate_lo = _value_at(system, k, NORMAL, t, y, stages, h, lo, modes, speeds, scratch)[1]
+@njit(cache=True, inline="always")
+def _extremum(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
+    """θ where ġ = 0 between lo and hi (ġ changes sign there), by bisection (NORMAL events, which know ġ)."""
+    rate_lo = _value_at(system, k, kind, t, y, stages, h, lo, modes, speeds, scratch)[1]
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        rate = _value_at(system, k, NORMAL, t, y, stages, h, mid, modes, speeds, scratch)[1]
+        rate = _value_at(system, k, kind, t, y, stages, h, mid, modes, speeds, scratch)[1]
         if (rate > 0.0) == (rate_lo > 0.0):
             lo, rate_lo = mid, rate
         else:
@@ -128,7 +136,7 @@ def _extremum(system, k, t, y, stages, h, lo, hi, modes, speeds, scratch):
     return 0.5 * (lo + hi)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _root(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
     """θ just past the crossing of g in [lo, hi] (Illinois false position on the dense output)."""
     mode = modes[k]
@@ -154,7 +162,7 @@ def _root(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
     return hi
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch):
     """θ in (0, 1] of joint k's first event of this kind in the step, or 2.0 when there is none."""
     mode = modes[k]
@@ -172,12 +180,26 @@ def first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
             return _root(system, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
         turning = (r_prev > 0.0 and r < 0.0) if mode == FREE else (r_prev < 0.0 and r > 0.0)
         if kind == NORMAL and turning:  # a graze: δ may cross and return between the two samples
-            peak = _extremum(system, k, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
+            peak = _extremum(system, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
             g_peak = _value_at(system, k, kind, t, y, stages, h, peak, modes, speeds, scratch)[0]
             if _crossed(mode, kind, g_prev, g_peak):
                 return _root(system, k, kind, t, y, stages, h, theta_prev, peak, modes, speeds, scratch)
         g_prev, r_prev, theta_prev = g, r, theta
     return 2.0
+
+
+@njit(cache=True, inline="always")
+def earliest_event(system, t, y, y_new, stages, h, modes, speeds, scratch):
+    """(θ, joint, kind) of the step's first event, or (2.0, −1, NORMAL) when there is none."""
+    event_theta = 2.0
+    event_joint = np.int64(-1)  # int64 from the start: a literal would compile each callee once more for it
+    event_kind = np.int64(NORMAL)
+    for k in range(modes.shape[0]):
+        for kind in range(2):
+            theta = first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
+            if theta < event_theta:
+                event_theta, event_joint, event_kind = theta, k, kind
+    return event_theta, event_joint, event_kind
 
 
 @njit(cache=True)
@@ -189,10 +211,11 @@ def project_state(system, t, y, modes):
     return violation
 
 
-@njit(cache=True)
-def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints,
-                 out_t, out_y, out_modes, out_speeds, out_episode, scratch):
-    """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected."""
+@njit(cache=True, inline="always")
+def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
+                 out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch):
+    """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives
+    from them (derive_sample)."""
     dt = real[R_SAMPLE_DT]
     while ints[I_NEXT_SAMPLE] < ints[I_TOTAL_SAMPLES]:
         sample_time = min(ints[I_NEXT_SAMPLE] * dt, real[R_T_END])
@@ -209,11 +232,13 @@ def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, rea
         out_modes[row, :] = modes
         out_speeds[row, :] = speeds
         out_episode[row, :] = episode_of
+        derive_sample(system, sample_time, scratch, modes, speeds, out_qdd[row], out_lam[row], out_contact[row],
+                      out_energies[row])
         ints[I_SAMPLES] += 1
         ints[I_NEXT_SAMPLE] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def contact_time_step(system, k, q, speed):
     """Initial step into contact: the Hertz contact time t_c = 3.218 (m/K)^(2/5) v^(−1/5), over 20."""
     mass = effective_mass(system, k, q)
@@ -227,8 +252,8 @@ def contact_time_step(system, k, q, speed):
     return t_c / 20.0, mass
 
 
-@njit(cache=True)
-def settle_friction(system, k, t, y, modes, speeds, may_stick=True):
+@njit(cache=True, inline="always")
+def settle_friction(system, k, t, y, modes, speeds, may_stick):
     """Choose how joint k's contact carries friction at time t: slide on, or stick if the wall can hold it.
 
     Sliding faster than DECIDE_SPEED goes on in its direction. Slower (a reversal, or a new contact
@@ -253,23 +278,25 @@ def settle_friction(system, k, t, y, modes, speeds, may_stick=True):
         project_state(system, t, y, modes)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_joint, log_onset, log_loss,
                 log_speed, log_mass):
     """Apply joint k's event at time t; returns the suggested next step."""
-    n = coordinate_count(system)
-    if kind == TANGENTIAL:
-        settle_friction(system, k, t, y, modes, speeds, modes[k] != STICK)
-        ints[I_FRICTION_EVENTS] += 1
-        return np.inf
-    if modes[k] != FREE:
+    if kind == NORMAL and modes[k] != FREE:  # contact lost
         modes[k] = FREE
         log_loss[episode_of[k]] = t
         episode_of[k] = -1
         return np.inf
-    speed = max(clearance_kinematics(system, k, y[:n], y[n:2 * n])[5], 0.0)
-    speeds[k] = speed
-    settle_friction(system, k, t, y, modes, speeds)
+    onset = kind == NORMAL
+    n = coordinate_count(system)
+    if onset:
+        speeds[k] = max(clearance_kinematics(system, k, y[:n], y[n:2 * n])[5], 0.0)
+    # a stick that just broke slides; a new contact or a sliding one may stick
+    settle_friction(system, k, t, y, modes, speeds, modes[k] != STICK)
+    if not onset:
+        ints[I_FRICTION_EVENTS] += 1
+        return np.inf
+    speed = speeds[k]
     h, mass = contact_time_step(system, k, y[:n], speed)
     row = ints[I_LOG]
     log_joint[row] = k
@@ -283,7 +310,7 @@ def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_join
     return h
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def consistent_modes(system, t, y, modes, speeds, episode_of, ints, log_joint, log_onset, log_loss,
                      log_speed, log_mass):
     """Switch joints whose mode disagrees with the state at the step start (initial state, restarts)."""
@@ -299,7 +326,7 @@ def consistent_modes(system, t, y, modes, speeds, episode_of, ints, log_joint, l
     return h
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def free_flight_limit(system, y, modes):
     """Longest step that keeps every free journal from crossing its clearance c."""
     n = coordinate_count(system)
@@ -322,7 +349,7 @@ def normal_force_at(system, k, y, stages, h, theta, modes, speeds, scratch):
     return contact_force_magnitudes(system, k, kin[4], kin[5], kin[8], modes[k], speeds[k])[0]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
     """Raise peak_force[k] to the largest F_n of the step: at 4 points, then at an interior maximum.
 
@@ -360,7 +387,7 @@ def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
         peak_force[k] = max(peak_force[k], best, fa, fb)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def refine_event(system, k, kind, t, y, f, h_event, modes, speeds, stages, y_event, ints):
     """Integrate from t exactly to joint k's event; returns the step length.
 
@@ -383,7 +410,8 @@ def refine_event(system, k, kind, t, y, f, h_event, modes, speeds, stages, y_eve
 
 @njit(cache=True)
 def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_onset, log_loss,
-            log_speed, log_mass, peak_force, out_t, out_y, out_modes, out_speeds, out_episode, t_stop):
+            log_speed, log_mass, peak_force, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam,
+            out_contact, out_energies, t_stop):
     """Integrate until t_stop, the end, a full buffer or a failure; the status is ints[I_STATUS]."""
     n = coordinate_count(system)
     stages = np.empty((STAGES, y.shape[0]))
@@ -391,6 +419,10 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
     scratch = np.empty_like(y)
     ints[I_STATUS] = RUNNING
     capacity = out_t.shape[0]
+    if real[R_STEP] <= 0.0:
+        rhs(system, real[R_TIME], y, modes, speeds, f)
+        ints[I_STATUS] = FIRST_STEP
+        return
     while True:
         t = real[R_TIME]
         if t >= real[R_T_END]:
@@ -409,8 +441,8 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             ints[I_RHS] += 1
             real[R_STEP] = min(real[R_STEP], switched)
         if ints[I_NEXT_SAMPLE] == 0:  # the first sample, in the modes the initial state has
-            emit_samples(system, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints,
-                         out_t, out_y, out_modes, out_speeds, out_episode, scratch)
+            emit_samples(system, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
+                         out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
         h = min(real[R_STEP], real[R_MAX_STEP], real[R_T_END] - t, free_flight_limit(system, y, modes))
         h = max(h, real[R_MIN_STEP])
         if capacity - ints[I_SAMPLES] < h / real[R_SAMPLE_DT] + 2.0:
@@ -431,14 +463,7 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             real[R_STEP] = max(h * max(0.2, SAFETY * norm ** -0.2), real[R_MIN_STEP])
             continue
         real[R_STEP] = h * min(10.0, max(0.2, SAFETY * norm ** -0.2)) if norm > 0.0 else 10.0 * h
-        event_theta = 2.0
-        event_joint = -1
-        event_kind = NORMAL
-        for k in range(modes.shape[0]):
-            for kind in range(2):
-                theta = first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
-                if theta < event_theta:
-                    event_theta, event_joint, event_kind = theta, k, kind
+        event_theta, event_joint, event_kind = earliest_event(system, t, y, y_new, stages, h, modes, speeds, scratch)
         if event_joint >= 0:
             h = refine_event(system, event_joint, event_kind, t, y, f, event_theta * h, modes, speeds, stages,
                              y_new, ints)
@@ -448,8 +473,8 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             if violation > DRIFT_LIMIT:
                 ints[I_STATUS] = DRIFT
                 return
-        emit_samples(system, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints,
-                     out_t, out_y, out_modes, out_speeds, out_episode, scratch)
+        emit_samples(system, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
+                     out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
         update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch)
         y[:] = y_new
         real[R_TIME] = t + h if h < real[R_T_END] - t else real[R_T_END]

@@ -1,8 +1,10 @@
-"""Quantities derived from the sampled states: accelerations, multipliers, contact forces, energies (compiled)."""
+"""Quantities derived from a sampled state: accelerations, multipliers, contact forces, energies (compiled).
+
+The integration loop derives them as it writes each sample: a kernel called from Python would load
+another copy of the dynamics it calls (memory, docs/performance.md)."""
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 from clearsim.assembly.constraints import constraint_count
@@ -14,37 +16,31 @@ from clearsim.assembly.forces import STICK, clearance_kinematics, contact_force_
 # columns of the per-joint contact output
 C_ECC_X, C_ECC_Y, C_PENETRATION, C_RATE, C_NORMAL, C_FRICTION, C_SLIDING = range(7)
 CONTACT_FIELDS = 7
+E_KINETIC, E_POTENTIAL, E_VIOLATION = range(3)  # columns of the per-sample energies
+ENERGY_FIELDS = 3
 
 
 @njit(cache=True)
-def evaluate_samples(system, times, states, modes, speeds):
-    """(q̈, λ, contact (S, nc, 7), kinetic, potential, violation) at every sample."""
-    samples = times.shape[0]
+def derive_sample(system, t, state, modes, speeds, qdd, lam, contact, energies):
+    """One sample's q̈ and λ into qdd and lam, its contact fields (nc, 7) into contact, and (kinetic, potential,
+    violation) into energies."""
     n = coordinate_count(system)
     m = constraint_count(system)
-    nc = system.clearance_bodies.shape[0]
-    qdd = np.zeros((samples, n))
-    lam = np.zeros((samples, m))
-    contact = np.zeros((samples, nc, CONTACT_FIELDS))
-    kinetic = np.zeros(samples)
-    potential = np.zeros(samples)
-    violation = np.zeros(samples)
-    for s in range(samples):
-        t = times[s]
-        q = states[s, :n].copy()
-        qd = states[s, n:2 * n].copy()
-        generalized = generalized_forces(system, t, q, qd, modes[s], speeds[s])[0]
-        qdd[s], multipliers = accelerations(system, t, q, qd, generalized, modes[s])
-        lam[s] = multipliers[:m]
-        for k in range(nc):
-            ex, ey, _, _, penetration, rate, _, _, sliding = clearance_kinematics(system, k, q, qd)
-            fn, ft, _ = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[s, k], speeds[s, k])
-            if modes[s, k] == STICK:
-                ft = -multipliers[stick_row_index(system, modes[s], k)]
-            contact[s, k, :] = (ex, ey, penetration, rate, fn, ft, sliding)
-        for b in range(system.mass.shape[0]):
-            kinetic[s] += 0.5 * (system.mass[b] * (qd[3 * b] ** 2 + qd[3 * b + 1] ** 2)
-                                 + system.inertia[b] * qd[3 * b + 2] ** 2)
-        potential[s] = potential_energy(system, q)
-        violation[s] = constraint_violation(system, t, q)
-    return qdd, lam, contact, kinetic, potential, violation
+    q = state[:n].copy()
+    qd = state[n:2 * n].copy()
+    generalized = generalized_forces(system, t, q, qd, modes, speeds)[0]
+    qdd[:], multipliers = accelerations(system, t, q, qd, generalized, modes)
+    lam[:] = multipliers[:m]
+    for k in range(system.clearance_bodies.shape[0]):
+        ex, ey, _, _, penetration, rate, _, _, sliding = clearance_kinematics(system, k, q, qd)
+        fn, ft, _ = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], speeds[k])
+        if modes[k] == STICK:
+            ft = -multipliers[stick_row_index(system, modes, k)]
+        contact[k, :] = (ex, ey, penetration, rate, fn, ft, sliding)
+    kinetic = 0.0
+    for b in range(system.mass.shape[0]):
+        kinetic += 0.5 * (system.mass[b] * (qd[3 * b] ** 2 + qd[3 * b + 1] ** 2)
+                          + system.inertia[b] * qd[3 * b + 2] ** 2)
+    energies[E_KINETIC] = kinetic
+    energies[E_POTENTIAL] = potential_energy(system, q)
+    energies[E_VIOLATION] = constraint_violation(system, t, q)

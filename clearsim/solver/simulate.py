@@ -15,12 +15,12 @@ from typing import Callable, Iterator
 import numpy as np
 
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints
-from clearsim.assembly.dynamics import WORK_COUNT, rhs
+from clearsim.assembly.dynamics import WORK_COUNT
 from clearsim.assembly.forces import FREE
 from clearsim.assembly.system import System
 from clearsim.errors import SolverError
 from clearsim.solver import integrator as ig
-from clearsim.solver.samples import evaluate_samples
+from clearsim.solver.samples import CONTACT_FIELDS, ENERGY_FIELDS, E_KINETIC, E_POTENTIAL, E_VIOLATION
 
 SAMPLE_BUFFER = 2048
 LOG_CAPACITY = 4096
@@ -103,9 +103,12 @@ class Run:
         self.ints[ig.I_TOTAL_SAMPLES] = int(np.floor(settings.t_end / dt + 1e-9)) + 1
         self.buffers = (np.zeros(SAMPLE_BUFFER), np.zeros((SAMPLE_BUFFER, self.y.size)),
                         np.zeros((SAMPLE_BUFFER, nc), np.int64), np.zeros((SAMPLE_BUFFER, nc)),
-                        np.zeros((SAMPLE_BUFFER, nc), np.int64))
-        rhs(arrays, 0.0, self.y, self.modes, self.speeds, self.f)
-        self.real[ig.R_STEP] = _initial_step(system, self.y, self.f)
+                        np.zeros((SAMPLE_BUFFER, nc), np.int64), np.zeros((SAMPLE_BUFFER, n)),
+                        np.zeros((SAMPLE_BUFFER, constraint_count(arrays))),
+                        np.zeros((SAMPLE_BUFFER, nc, CONTACT_FIELDS)), np.zeros((SAMPLE_BUFFER, ENERGY_FIELDS)))
+        # no first step yet: the loop's first call returns FIRST_STEP with ẏ(0) in f and _initial_step chooses it
+        # here (numpy's sums, as always: the step, and so every result, stays bitwise the same); calling the
+        # compiled rhs from Python instead would load a second copy of the dynamics (docs/performance.md)
         self.wall_time = 0.0
         self.coordinate_count = n
 
@@ -139,10 +142,10 @@ class Run:
         count = int(self.ints[ig.I_SAMPLES])
         if count == 0:
             return None
-        times, states, modes, speeds, episodes = (b[:count].copy() for b in self.buffers)
+        times, states, modes, speeds, episodes, qdd, lam, contact, energies = (b[:count].copy() for b in self.buffers)
         self.ints[ig.I_SAMPLES] = 0
-        derived = evaluate_samples(self.system.arrays, times, states, modes, speeds)
-        return Chunk(times, states, modes, speeds, episodes, *derived)
+        return Chunk(times, states, modes, speeds, episodes, qdd, lam, contact,
+                     energies[:, E_KINETIC], energies[:, E_POTENTIAL], energies[:, E_VIOLATION])
 
     def chunks(self) -> Iterator[Chunk]:
         """Integrate to t_end, yielding samples as they come; SolverError on failure (after the samples)."""
@@ -151,6 +154,9 @@ class Run:
         while True:
             self._advance(next_stop)
             status = int(self.ints[ig.I_STATUS])
+            if status == ig.FIRST_STEP:
+                self.real[ig.R_STEP] = _initial_step(self.system, self.y, self.f)
+                continue
             if status == ig.BUFFER_FULL and self.ints[ig.I_LOG] >= self.log[0].size - len(self.modes) - 1:
                 self._grow_log()
             chunk = self._take_samples()

@@ -11,7 +11,8 @@ from clearsim.sweep.grid import SweepOptionError
 from clearsim.sweep.plan import CASES_FILE, SweepPlan, write_cases
 from clearsim.sweep.summary import (PERCENTILES_FILE, SUMMARY_FILE, percentile_header, percentiles,
                                     summary_rows, write_csv)
-from clearsim.sweep.worker import COMPLETE, FAILED, INTERRUPTED, NOT_RUN, CaseOutcome, CaseTask, run_case
+from clearsim.sweep.worker import (COMPLETE, FAILED, INTERRUPTED, NOT_RUN, CaseOutcome, CaseTask, finished_outcome,
+                                   run_case)
 
 Progress = Callable[[CaseOutcome, int, int], None]  # (outcome, finished, total)
 
@@ -71,11 +72,20 @@ def run_sweep(plan: SweepPlan, executor, progress: Progress | None = None,
         interrupted = executor.run(run_case, tasks, collect)
     except KeyboardInterrupt:
         interrupted = True
+    if interrupted:
+        outcomes.update(recovered(tasks, outcomes))
     interrupted = interrupted or any(o.state in (INTERRUPTED, NOT_RUN) for o in outcomes.values())
     result = _summarize(plan, outcomes, interrupted)
     if interrupted:
         raise SweepInterrupted(result)
     return result
+
+
+def recovered(tasks: list[CaseTask], outcomes: dict[str, CaseOutcome]) -> dict[str, CaseOutcome]:
+    """After Ctrl-C: the cases whose worker finished the file as the interruption came, so that their outcome
+    never reached this process (or said interrupted), read back from their complete files."""
+    unsettled = [t for t in tasks if t.name not in outcomes or outcomes[t.name].state in (INTERRUPTED, NOT_RUN)]
+    return {t.name: outcome for t in unsettled if (outcome := finished_outcome(t)) is not None}
 
 
 def _check_folder(folder: Path) -> None:

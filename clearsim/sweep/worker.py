@@ -116,14 +116,22 @@ def _attempt(task: CaseTask) -> CaseOutcome:
 
 def _after_interrupt(task: CaseTask) -> CaseOutcome:
     """An interruption that came after the file was complete (reading it back) leaves a complete case."""
+    return finished_outcome(task) or CaseOutcome(task.name, INTERRUPTED, True, "interrupted")
+
+
+def finished_outcome(task: CaseTask) -> CaseOutcome | None:
+    """The case's outcome read from its file when that is complete and of this case's YAML, else None."""
     try:
         loaded = load_mechanism_text(task.config_text, task.config_name, task.overrides, Path(task.base_dir))
         output = Path(task.output)
-        if output.exists() and read_result(output)["attrs"].get("complete"):
+        if not output.exists():
+            return None
+        attrs = read_result(output)["attrs"]
+        if attrs.get("complete") and attrs.get("config_yaml") == loaded.resolved_yaml:
             return _outcome(task.name, output, loaded.mechanism.output, ran=True)
     except (ClearsimError, NotAResultFile, OSError):
         pass
-    return CaseOutcome(task.name, INTERRUPTED, True, "interrupted")
+    return None
 
 
 def _outcome(name: str, output: Path, output_sensors, ran: bool) -> CaseOutcome:

@@ -11,6 +11,8 @@ from pathlib import Path
 import h5py
 
 from clearsim.sweep import LocalPool, SweepRequest, plan_sweep, run_sweep
+from clearsim.sweep.execute import recovered, tasks_of
+from clearsim.sweep.worker import COMPLETE, INTERRUPTED, CaseOutcome, run_case
 
 SLIDER_CRANK = Path(__file__).resolve().parents[2] / "clearsim" / "configs" / "slider_crank_flores.yaml"
 CLEARANCES = "0.05,0.1,0.2,0.3,0.4,0.5,0.6"
@@ -45,3 +47,22 @@ def test_ctrl_c_keeps_finished_cases_and_a_rerun_resumes(tmp_path):
     result = run_sweep(plan, LocalPool(2))
     assert sorted(result.ran) == sorted(set(status) - finished)
     assert result.count("complete") == 8
+
+
+def test_a_case_finished_as_ctrl_c_came_is_read_back_from_its_complete_file(tmp_path):
+    """The race behind a flaky run of the test above: a worker writes its file complete, Ctrl-C comes before its
+    outcome reaches the sweep, and the summary called the case not run. `recovered` reads such cases back from
+    their files — only complete files of the case's own YAML."""
+    plan = plan_sweep(SweepRequest(SLIDER_CRANK, ["solver.t_end=2ms"], "0.1,0.2,0.3", out=tmp_path / "sweep"),
+                      SLIDER_CRANK)
+    plan.folder.mkdir(parents=True)
+    tasks = tasks_of(plan)
+    finished = run_case(tasks[0])
+    assert finished.state == COMPLETE
+    other = tasks[1]
+    Path(tasks[0].output).with_name("copy.h5").write_bytes(Path(tasks[0].output).read_bytes())
+    Path(tasks[0].output).with_name("copy.h5").replace(other.output)  # complete, but of another case's YAML
+    back = recovered(tasks, {other.name: CaseOutcome(other.name, INTERRUPTED, True, "interrupted")})
+    assert set(back) == {tasks[0].name}  # the third has no file; the second's file is not its own
+    assert back[tasks[0].name].state == COMPLETE
+    assert back[tasks[0].name].record.peak_acceleration == finished.record.peak_acceleration

@@ -77,6 +77,10 @@ class Point:
     def low_band_chi_square(self) -> float:
         return self.low_band.chi_square if self.low_band is not None else np.inf
 
+    def chi_square_in(self, low_band: bool) -> float:
+        """χ² in the screening band (low_band) or in the comparison band."""
+        return self.low_band_chi_square if low_band else self.chi_square
+
 
 @dataclass
 class Scored:
@@ -94,8 +98,16 @@ class Scored:
     windows: dict[bool, tuple[float, float]] = field(default_factory=dict)  # rough: per band (low_band?), centre
     # and half-width (unit range) of its window
     profiles: dict[bool, tuple[float, float]] = field(default_factory=dict)  # rough: per band, smoothed vertex, error
-    smoothed: tuple[float, float] | None = None  # rough candidate: the better-determined band's vertex and error
-    smoothed_in_low_band: bool = False  # that band is the screening band
+
+    @property
+    def smoothed_in_low_band(self) -> bool:
+        """A rough candidate's estimate comes from the band where its smoothed minimum is better determined."""
+        return min(self.profiles, key=lambda band: self.profiles[band][1])
+
+    @property
+    def smoothed(self) -> tuple[float, float] | None:
+        """A rough candidate's smoothed vertex and its uncertainty (unit range) in that band; None otherwise."""
+        return self.profiles[self.smoothed_in_low_band] if self.profiles else None
 
     @property
     def best(self) -> Point | None:
@@ -200,13 +212,12 @@ BANDS = (False, True)  # a rough candidate's profile is smoothed in the comparis
 
 def lowest(scored: Scored, low_band: bool) -> Point:
     """The run with the lowest χ² in the comparison band, or in the screening band."""
-    return min((p for p in scored.points if p.fit is not None),
-               key=lambda p: p.low_band_chi_square if low_band else p.chi_square)
+    return min((p for p in scored.points if p.fit is not None), key=lambda p: p.chi_square_in(low_band))
 
 
 def low_band_best(scored: Scored) -> float:
     """The lowest χ² of the candidate's runs in the screening band."""
-    return min((p.low_band_chi_square for p in scored.points), default=np.inf)
+    return lowest(scored, True).low_band_chi_square
 
 
 def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
@@ -225,9 +236,6 @@ def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
         for s in rough if round_ < ROUGH_ROUNDS else []:
             s.profiles = {band: _smoothed_minimum(s, *s.windows[band], band) for band in BANDS}
             s.windows = {band: (s.profiles[band][0], s.windows[band][1] / 2.0) for band in BANDS}
-    for s in rough:
-        s.smoothed_in_low_band = min(BANDS, key=lambda band: s.profiles[band][1])
-        s.smoothed = s.profiles[s.smoothed_in_low_band]
     jobs = [(s, v) for s in smooth if (v := profile_vertex(s)) is not None]
     jobs += [(s, float(s.candidate.from_unit(s.smoothed[0]))) for s in rough]
     evaluate_points(evaluator, record, sensors, jobs, document)
@@ -238,7 +246,8 @@ def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
 def _window_values(scored: Scored) -> list[float]:
     """ROUGH_POINTS values evenly spread inside each band's window of the rough candidate (ends excluded), within
     the bounds, new ones only."""
-    units = [centre + half * u for centre, half in scored.windows.values() for u in np.linspace(-1.0, 1.0, ROUGH_POINTS + 2)[1:-1]]
+    spread = np.linspace(-1.0, 1.0, ROUGH_POINTS + 2)[1:-1]
+    units = [centre + half * u for centre, half in scored.windows.values() for u in spread]
     known = {p.value for p in scored.points}
     values = [float(scored.candidate.from_unit(u)) for u in units if 0.0 <= u <= 1.0]
     return [v for v in dict.fromkeys(values) if v not in known]
@@ -253,7 +262,7 @@ def _smoothed_minimum(scored: Scored, centre: float, half: float, low_band: bool
     vertex leaves the window: the lowest run in the window, with the window's half-width as the uncertainty."""
     points = [p for p in scored.points if p.fit is not None]
     units = scored.candidate.to_unit([p.value for p in points])
-    chi = np.array([p.low_band_chi_square if low_band else p.chi_square for p in points])
+    chi = np.array([p.chi_square_in(low_band) for p in points])
     inside = np.abs(units - centre) <= half * (1.0 + 1e-9)
     if inside.sum() >= 6:  # polyfit's covariance needs more points than coefficients + 2
         coefficients, covariance = np.polyfit(units[inside] - centre, chi[inside], 2, cov=True)
@@ -277,7 +286,7 @@ def profile_vertex(scored: Scored, low_band: bool = False) -> float | None:
     if len(points) < 4:
         return None
     units = scored.candidate.to_unit([p.value for p in points])
-    chi = np.array([p.low_band_chi_square if low_band else p.chi_square for p in points])
+    chi = np.array([p.chi_square_in(low_band) for p in points])
     if not np.all(np.isfinite(chi)):
         return None
     centre = float(units[np.argmin(chi)])

@@ -54,6 +54,7 @@ class Study:
 
 STUDIES = [
     Study("uhv-bundled-clearance-B", UHV, [], ["joints.B.clearance=0.08mm"], "clearance B 0.08 mm", UHV_BENCH, "1%", []),
+    Study("uhv-bundled-no-effect", UHV, [], [], "none", UHV_BENCH, "1%", [], seed=11),
     Study("uhv-clearance-B", UHV, FRICTIONLESS_UHV, ["joints.B.clearance=0.08mm"], "clearance B 0.08 mm", UHV_BENCH,
           "0.05%", ["--candidates", "clearance,drive"]),
     Study("uhv-drive-lag", UHV, FRICTIONLESS_UHV, ["drivers.hydraulic_drive.lag=2ms"], "drive lag 2 ms", UHV_BENCH,
@@ -78,7 +79,7 @@ STUDIES = [
 ]
 
 
-SLOW = {"uhv-bundled-clearance-B"}
+SLOW = {"uhv-bundled-clearance-B", "uhv-bundled-no-effect"}
 
 
 def sets(values: list[str]) -> list[str]:
@@ -138,7 +139,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("results/diagnose-studies"))
     parser.add_argument("--only", help="run one study by name")
     parser.add_argument("--fresh", action="store_true", help="delete earlier run files first (to time the studies)")
-    parser.add_argument("--all", action="store_true", help="also the bundled UHV model (stiction friction: ~12 min)")
+    parser.add_argument("--all", action="store_true", help="also the bundled UHV model studies (~7 min)")
     args = parser.parse_args()
     if args.fresh and args.out.exists():
         shutil.rmtree(args.out)

@@ -24,8 +24,8 @@ from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for, with_
 from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
 from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
-from clearsim.diagnose.search import (SIGNIFICANCE, JointFit, Point, Scored, halves_improved, judge, mark_ties, refine,
-                                     refit_jointly, score_point, screen, seen_by_sensors, to_fit)
+from clearsim.diagnose.search import (SIGNIFICANCE, JointFit, Point, Scored, halves_improved, judge, low_band_best,
+                                     mark_ties, refine, refit_jointly, score_point, screen, seen_by_sensors, to_fit)
 from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.model.loader import load_mechanism, load_mechanism_text
 from clearsim.units import UnitError, to_si
@@ -252,6 +252,10 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     refine(evaluator, record, sensors, chosen, document)
     ranked = judge(scored, baseline, record)
     winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
+    if winner is not None and not seen_below_chaos(winner, base_point, record):
+        say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) only above the screening band "
+            f"({record.low_band.cutoff:.0f} Hz): chaotic detail of the impacts, not a missing effect")
+        winner = None
     if winner is not None:
         mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
         winner.halves = halves_improved(record, base_point, winner.estimate)
@@ -259,6 +263,16 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
+
+
+def seen_below_chaos(scored: Scored, baseline: Point, record: Record) -> bool:
+    """A found effect must also explain the record in the screening band, below the chaotic detail of single
+    impacts: its lowest χ² there beats the model's by the same BIC margin (ln n_eff of that band + SIGNIFICANCE).
+    A run that matches the record's impact sequence by chance improves only the comparison band."""
+    if record.low_band is None or record.low_band.cutoff is None:
+        return True
+    margin = np.log(max(record.low_band.effective_samples, 2.0)) + SIGNIFICANCE
+    return low_band_best(scored) < baseline.low_band_chi_square - margin
 
 
 def effect_line(effect: Effect) -> str:

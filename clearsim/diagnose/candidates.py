@@ -120,13 +120,17 @@ CLEARANCE_BOUNDS = (2e-6, 0.5e-3)  # m: 2 µm (a tight fit) to 0.5 mm (a worn pi
 DEFAULT_BEARING_RADIUS = 0.01  # m, given to a new clearance joint when the file knows none
 
 
+def _radius_missing(mechanism, joint) -> bool:
+    """Neither the joint nor `defaults` gives a bearing radius: a new clearance joint gets DEFAULT_BEARING_RADIUS."""
+    return mechanism.defaults.bearing_radius is None and joint.bearing_radius is None and joint.journal_radius is None
+
+
 def clearance(mechanism, document) -> list[Candidate]:
     """Radial clearance c of each revolute joint (an ideal one becomes a clearance joint)."""
-    needs_radius = mechanism.defaults.bearing_radius is None
     out = []
     for joint in _revolute(mechanism):
         current = resolve_clearance(joint, mechanism.defaults).clearance if is_clearance_joint(joint) else None
-        radius_missing = needs_radius and joint.bearing_radius is None and joint.journal_radius is None
+        radius_missing = _radius_missing(mechanism, joint)
 
         def write(doc, value, name=joint.name, add_radius=radius_missing):
             if add_radius:
@@ -149,11 +153,10 @@ def friction(mechanism, document) -> list[Candidate]:
     friction circle), with the file's default friction law. Rough: friction reaches kinematic sensors through
     the chaotic journal motion, so χ² over μ_d is a comb of narrow minima (slider-crank: teeth ~0.004 wide in
     μ_d) over a smooth basin."""
-    needs_radius = mechanism.defaults.bearing_radius is None
     out = []
     for joint in _revolute(mechanism):
         pin = not is_clearance_joint(joint)
-        radius_missing = pin and needs_radius and joint.bearing_radius is None and joint.journal_radius is None
+        radius_missing = pin and _radius_missing(mechanism, joint)
         as_journal = joint.model_copy(update={"clearance": PIN_CLEARANCE, "journal_radius": None,
                                               **({"bearing_radius": DEFAULT_BEARING_RADIUS} if radius_missing else {})})
         p = resolve_clearance(as_journal if pin else joint, mechanism.defaults)

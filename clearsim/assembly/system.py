@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from clearsim.assembly import build
-from clearsim.assembly.arrays import SystemArrays
+from clearsim.assembly.arrays import KernelArrays, SystemArrays, for_kernels
 from clearsim.assembly.build import BuildError, ConstraintRows, Laws, Poses
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints, evaluate_jacobian, evaluate_velocity_rhs
 from clearsim.errors import Problem
@@ -133,7 +133,7 @@ def _pinned_clearances(arrays: SystemArrays, clearances: list) -> SystemArrays:
     )
 
 
-def _newton_assembly(arrays: SystemArrays, q: np.ndarray, owners: list[str]) -> np.ndarray:
+def _newton_assembly(arrays: KernelArrays, q: np.ndarray, owners: list[str]) -> np.ndarray:
     """Minimum-norm Newton steps on Φ(q, 0) = 0; BuildError naming the worst rows if it fails."""
     m = constraint_count(arrays)
     if m == 0:
@@ -153,7 +153,7 @@ def _newton_assembly(arrays: SystemArrays, q: np.ndarray, owners: list[str]) -> 
                               "check the joint locations and link lengths: the loop through these joints does not close")])
 
 
-def _consistent_velocities(arrays: SystemArrays, q: np.ndarray, qd: np.ndarray, mass_diag: np.ndarray,
+def _consistent_velocities(arrays: KernelArrays, q: np.ndarray, qd: np.ndarray, mass_diag: np.ndarray,
                            clearances: list, first_clearance_row: int) -> np.ndarray:
     """The velocity nearest to qd in the M metric with Φ_q q̇ = ν(0), journals at their initial relative velocity."""
     m = constraint_count(arrays)
@@ -171,7 +171,7 @@ def _consistent_velocities(arrays: SystemArrays, q: np.ndarray, qd: np.ndarray, 
     return qd - scale * correction
 
 
-def _check_rank(arrays: SystemArrays, q: np.ndarray, owners: list[str]) -> int:
+def _check_rank(arrays: KernelArrays, q: np.ndarray, owners: list[str]) -> int:
     """Rank of Φ_q; BuildError naming the joints of a redundant set."""
     m = constraint_count(arrays)
     if m == 0:
@@ -227,10 +227,11 @@ def assemble(mechanism: schema.Mechanism, base_dir: Path | str = ".") -> System:
     owners = rows.row_owners()
     assembly_arrays = _pinned_clearances(arrays, clearances)
     assembly_owners = owners[: 2 * len(rows.pins)] + [c[-1] for c in clearances for _ in range(2)] + owners[2 * len(rows.pins):]
-    q0 = _newton_assembly(assembly_arrays, _initial_coordinates(mechanism), assembly_owners)
-    rank = _check_rank(arrays, q0, owners)
+    assembly_kernel_arrays = for_kernels(assembly_arrays)
+    q0 = _newton_assembly(assembly_kernel_arrays, _initial_coordinates(mechanism), assembly_owners)
+    rank = _check_rank(for_kernels(arrays), q0, owners)
     mass_diag = np.column_stack([arrays.mass, arrays.mass, arrays.inertia]).ravel()
-    qd0 = _consistent_velocities(assembly_arrays, q0, _initial_velocities(mechanism), mass_diag,
+    qd0 = _consistent_velocities(assembly_kernel_arrays, q0, _initial_velocities(mechanism), mass_diag,
                                  clearances, 2 * len(rows.pins))
     n_offsets = len(rows.offsets)
     return System(

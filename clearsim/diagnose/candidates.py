@@ -17,6 +17,7 @@ from typing import Callable
 import numpy as np
 
 from clearsim.assembly.build import BuildError, initial_poses, joint_points
+from clearsim.assembly.arrays import for_kernels
 from clearsim.assembly.dynamics import accelerations, generalized_forces
 from clearsim.assembly.system import assemble
 from clearsim.diagnose.evaluate import document_text
@@ -403,8 +404,9 @@ def initial_tension(document: dict, split: LinkSplit, base_dir: Path) -> float:
     except (BuildError, ClearsimError, ValueError):
         return 0.0
     free = np.zeros(len(system.clearance_joints), np.int64)  # every journal starts in free flight (mode FREE)
-    forces = generalized_forces(system.arrays, 0.0, system.q0, system.qd0, free, np.zeros(free.size))[0]
-    multipliers = accelerations(system.arrays, 0.0, system.q0, system.qd0, forces, free)[1]
+    kernel_arrays = for_kernels(system.arrays)
+    forces = generalized_forces(kernel_arrays, 0.0, system.q0, system.qd0, free, np.zeros(free.size))[0]
+    multipliers = accelerations(kernel_arrays, 0.0, system.q0, system.qd0, forces, free)[1]
     return float(multipliers[dict(system.drivers)[lock]])
 
 

@@ -14,6 +14,7 @@ from typing import Callable, Iterator
 
 import numpy as np
 
+from clearsim.assembly.arrays import for_kernels
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints
 from clearsim.assembly.dynamics import WORK_COUNT
 from clearsim.assembly.forces import FREE
@@ -86,6 +87,7 @@ class Run:
         self.system = system
         settings = system.mechanism.solver
         arrays = system.arrays
+        self.kernel_arrays = for_kernels(arrays)
         nc = len(system.clearance_joints)
         n = system.coordinate_count
         self.y = np.concatenate([system.q0, system.qd0, np.zeros(WORK_COUNT)])
@@ -104,7 +106,7 @@ class Run:
         self.buffers = (np.zeros(SAMPLE_BUFFER), np.zeros((SAMPLE_BUFFER, self.y.size)),
                         np.zeros((SAMPLE_BUFFER, nc), np.int64), np.zeros((SAMPLE_BUFFER, nc)),
                         np.zeros((SAMPLE_BUFFER, nc), np.int64), np.zeros((SAMPLE_BUFFER, n)),
-                        np.zeros((SAMPLE_BUFFER, constraint_count(arrays))),
+                        np.zeros((SAMPLE_BUFFER, constraint_count(self.kernel_arrays))),
                         np.zeros((SAMPLE_BUFFER, nc, CONTACT_FIELDS)), np.zeros((SAMPLE_BUFFER, ENERGY_FIELDS)))
         # no first step yet: the loop's first call returns FIRST_STEP with ẏ(0) in f and _initial_step chooses it
         # here (numpy's sums, as always: the step, and so every result, stays bitwise the same); calling the
@@ -134,7 +136,7 @@ class Run:
 
     def _advance(self, t_stop: float) -> None:
         started = clock.perf_counter()
-        ig.advance(self.system.arrays, self.y, self.f, self.real, self.ints, self.modes, self.speeds,
+        ig.advance(self.kernel_arrays, self.y, self.f, self.real, self.ints, self.modes, self.speeds,
                    self.episode_of, *self.log, self.peak_force, *self.buffers, t_stop)
         self.wall_time += clock.perf_counter() - started
 
@@ -196,9 +198,9 @@ class Run:
     def _involved_joint(self, status: int) -> str | None:
         system = self.system
         if status == ig.DRIFT:
-            m = constraint_count(system.arrays)
+            m = constraint_count(self.kernel_arrays)
             phi = np.zeros(m)
-            evaluate_constraints(system.arrays, self.time, self.y[: self.coordinate_count], phi)
+            evaluate_constraints(self.kernel_arrays, self.time, self.y[: self.coordinate_count], phi)
             return system.row_owners[int(np.argmax(np.abs(phi)))] if m else None
         if status in (ig.TOO_DEEP, ig.CHATTER) and self.ints[ig.I_FAIL_JOINT] >= 0:
             return system.clearance_joints[int(self.ints[ig.I_FAIL_JOINT])]

@@ -3,18 +3,18 @@
 import numpy as np
 import pytest
 
-from clearsim.assembly.arrays import CLEARANCE_COLUMNS, LOAD_COLUMNS, SPRING_COLUMNS, SystemArrays
+from clearsim.assembly.arrays import CLEARANCE_COLUMNS, LOAD_COLUMNS, SPRING_COLUMNS, KernelArrays, SystemArrays, for_kernels
 from clearsim.assembly.constraints import (
     constraint_count, evaluate_acceleration_rhs, evaluate_constraints, evaluate_jacobian, evaluate_velocity_rhs,
 )
 from clearsim.physics import motion
 
 
-def mixed_system() -> SystemArrays:
-    """Three bodies with one of each primitive, two of them driven, and a body pinned to ground."""
+def mixed_system() -> KernelArrays:
+    """Three bodies with one of each primitive, two of them driven, and a body pinned to ground (as the kernels take it)."""
     law = motion.polynomial_law([0.3, -0.7, 0.2])
     breaks, coefficients, first, count = motion.concatenate([law, motion.stroke_law(0.4, 0.05)])
-    return SystemArrays(
+    return for_kernels(SystemArrays(
         mass=np.array([1.0, 2.0, 3.0]), inertia=np.array([0.1, 0.2, 0.3]), gravity=np.zeros(2),
         pin_bodies=np.array([[-1, 0], [0, 1]]), pin_points=np.array([[0.1, 0.2, -0.3, 0.05], [0.2, -0.1, 0.4, 0.3]]),
         offset_bodies=np.array([[1, 2], [0, 2]]),
@@ -26,7 +26,7 @@ def mixed_system() -> SystemArrays:
         clearance_params=np.zeros((0, CLEARANCE_COLUMNS)),
         load_bodies=np.zeros(0, np.int64), load_params=np.zeros((0, LOAD_COLUMNS)), load_law=np.zeros(0, np.int64),
         spring_bodies=np.zeros((0, 2), np.int64), spring_params=np.zeros((0, SPRING_COLUMNS)),
-    )
+    ))
 
 
 def phi(system, t, q):

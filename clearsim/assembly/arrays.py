@@ -88,3 +88,11 @@ def _pack(fields):
 def for_kernels(arrays: SystemArrays) -> KernelArrays:
     """The arrays as every compiled kernel takes them (one compiled specialisation for all callers)."""
     return _pack(tuple(arrays))
+
+
+@njit(cache=True, inline="always")
+def copy_into(out, values):
+    """out[...] = values element by element (1-D): a slice assignment would compile numba's shape-mismatch
+    message, 1.4 s of compile time for a check the callers' fixed sizes make needless."""
+    for i in range(values.shape[0]):
+        out[i] = values[i]

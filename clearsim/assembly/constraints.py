@@ -131,7 +131,8 @@ def evaluate_jacobian(system, q, jac):
     for row in range(blocks.shape[0]):
         for slot in range(2):
             if bodies[row, slot] >= 0:
-                jac[row, 3 * bodies[row, slot]:3 * bodies[row, slot] + 3] += blocks[row, slot]
+                for axis in range(3):  # element by element: a slice += compiles numba's shape-error message (1.4 s)
+                    jac[row, 3 * bodies[row, slot] + axis] += blocks[row, slot, axis]
 
 
 @njit(cache=True)

@@ -23,7 +23,7 @@ from clearsim.assembly.forces import (
     STICK, add_applied_forces, add_clearance_forces, add_global_force, clearance_kinematics, stick_row,
 )
 from clearsim.assembly.kinematics import point_position
-from clearsim.assembly.arrays import CL_BEARING_POINT
+from clearsim.assembly.arrays import CL_BEARING_POINT, copy_into
 
 WORK_DRIVER = 0
 WORK_CONTACT = 1
@@ -157,7 +157,8 @@ def accelerations(system, t, q, qd, generalized, modes):
     blocks, bodies, curvature = jacobian_with_sticks(system, q, qd, modes)
     gamma = np.empty(m + sticking)
     evaluate_acceleration_rhs(system, t, q, qd, gamma)
-    gamma[m:] = -curvature
+    for i in range(sticking):
+        gamma[m + i] = -curvature[i]
     return constrained_response(blocks, bodies, minv, generalized, gamma)
 
 
@@ -192,8 +193,8 @@ def rhs(system, t, y, modes, impact_speeds, ydot):
     qd = y[n:2 * n]
     generalized, applied, damping, contact, friction = generalized_forces(system, t, q, qd, modes, impact_speeds)
     qdd, lam = accelerations(system, t, q, qd, generalized, modes)
-    ydot[:n] = qd
-    ydot[n:2 * n] = qdd
+    copy_into(ydot[:n], qd)
+    copy_into(ydot[n:2 * n], qdd)
     ydot[2 * n + WORK_DRIVER] = driver_power(system, t, lam)
     ydot[2 * n + WORK_CONTACT] = contact
     ydot[2 * n + WORK_FRICTION] = friction

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from clearsim.assembly.arrays import copy_into
 from clearsim.assembly.dynamics import rhs
 
 STAGES = 7
@@ -37,7 +38,7 @@ DENSE = np.array([
 @njit(cache=True)
 def _accumulate(out, base, coefficients, h, stages, count):
     """out = base + Σ_{j<count} (h a_j) K_j, skipping zero coefficients (no temporaries)."""
-    out[:] = base
+    copy_into(out, base)
     for j in range(count):
         if coefficients[j] != 0.0:
             weight = h * coefficients[j]
@@ -48,7 +49,7 @@ def _accumulate(out, base, coefficients, h, stages, count):
 @njit(cache=True, inline="always")
 def step(system, t, y, f, h, modes, speeds, stages, y_new):
     """One DOPRI5 step from (t, y) with ẏ(t) = f; fills stages (7, ny) and y_new; returns the error vector."""
-    stages[0, :] = f
+    copy_into(stages[0], f)
     work = np.empty_like(y)
     # nodes at the step's end are evaluated just left of it: a prescribed motion may jump in acceleration
     # exactly there (the end of a stroke), and the step must see the piece it integrates over
@@ -76,7 +77,7 @@ def error_norm(error, y, y_new, count, rtol, atol):
 @njit(cache=True)
 def interpolate(y, stages, h, theta, out):
     """Continuous extension y(t + θh) into out."""
-    out[:] = y
+    copy_into(out, y)
     for j in range(STAGES):
         weight = 0.0
         power = theta

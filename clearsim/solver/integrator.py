@@ -29,7 +29,7 @@ import numpy as np
 from numba import njit
 
 from clearsim.assembly.arrays import (
-    CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_STIFFNESS,
+    CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_STIFFNESS, copy_into,
 )
 from clearsim.assembly.dynamics import (
     accelerations, coordinate_count, effective_mass, generalized_forces, project_positions, project_velocities, rhs,
@@ -225,13 +225,13 @@ def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, rea
         if h > 0.0:
             interpolate(y, stages, h, (sample_time - t) / h, scratch)
         else:
-            scratch[:] = y
+            copy_into(scratch, y)
         project_state(system, sample_time, scratch, modes)
         out_t[row] = sample_time
-        out_y[row, :] = scratch
-        out_modes[row, :] = modes
-        out_speeds[row, :] = speeds
-        out_episode[row, :] = episode_of
+        copy_into(out_y[row], scratch)
+        copy_into(out_modes[row], modes)
+        copy_into(out_speeds[row], speeds)
+        copy_into(out_episode[row], episode_of)
         derive_sample(system, sample_time, scratch, modes, speeds, out_qdd[row], out_lam[row], out_contact[row],
                       out_energies[row])
         ints[I_SAMPLES] += 1
@@ -476,7 +476,7 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
         emit_samples(system, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
                      out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
         update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch)
-        y[:] = y_new
+        copy_into(y, y_new)
         real[R_TIME] = t + h if h < real[R_T_END] - t else real[R_T_END]
         ints[I_STEPS] += 1
         ints[I_STALLED] = ints[I_STALLED] + 1 if h < real[R_MIN_STEP] else 0

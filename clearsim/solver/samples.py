@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from numba import njit
 
+from clearsim.assembly.arrays import copy_into
 from clearsim.assembly.constraints import constraint_count
 from clearsim.assembly.dynamics import (
     accelerations, constraint_violation, coordinate_count, generalized_forces, stick_row_index,
@@ -29,14 +30,17 @@ def derive_sample(system, t, state, modes, speeds, qdd, lam, contact, energies):
     q = state[:n].copy()
     qd = state[n:2 * n].copy()
     generalized = generalized_forces(system, t, q, qd, modes, speeds)[0]
-    qdd[:], multipliers = accelerations(system, t, q, qd, generalized, modes)
-    lam[:] = multipliers[:m]
+    accelerations_, multipliers = accelerations(system, t, q, qd, generalized, modes)
+    copy_into(qdd, accelerations_)
+    copy_into(lam, multipliers[:m])
     for k in range(system.clearance_bodies.shape[0]):
         ex, ey, _, _, penetration, rate, _, _, sliding = clearance_kinematics(system, k, q, qd)
         fn, ft, _ = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], speeds[k])
         if modes[k] == STICK:
             ft = -multipliers[stick_row_index(system, modes, k)]
-        contact[k, :] = (ex, ey, penetration, rate, fn, ft, sliding)
+        fields = contact[k]
+        fields[C_ECC_X], fields[C_ECC_Y], fields[C_PENETRATION], fields[C_RATE] = ex, ey, penetration, rate
+        fields[C_NORMAL], fields[C_FRICTION], fields[C_SLIDING] = fn, ft, sliding
     kinetic = 0.0
     for b in range(system.mass.shape[0]):
         kinetic += 0.5 * (system.mass[b] * (qd[3 * b] ** 2 + qd[3 * b + 1] ** 2)

@@ -40,10 +40,9 @@ from friction_ensemble import (FORMATS, IDEAL, LABELS, MU_D, PAIRED, command_lin
 from paper_studies import FIGURES, ROOT, new_figure  # noqa: E402
 
 from clearsim.io.hdf5 import read_result  # noqa: E402
-from tests.support.uhv_actuator import (CALIBRATED, FORCE_DRIVE, actuator_overrides,  # noqa: E402
-                                        effort_history_overrides)
+from tests.support.uhv_actuator import (CALIBRATED, FORCE_DRIVE, actuator_overrides, crossing_time,  # noqa: E402
+                                        effort_history_overrides, mean_speed)
 
-STROKE = 0.300  # m: the moving contact's stroke under the drive law (docs/uhv-geometry.md)
 FIT_STEP = 50  # fit the displacement every 50th sample (0.5 ms)
 SCALES = (1e4, 1e5, 1e3)  # N, N/m, N·s/m: the fit's parameters in these units are of order 1
 DIGITS = 4  # CALIBRATED is the fit rounded to this many significant digits
@@ -61,29 +60,20 @@ PAIRED_ALL = (*PAIRED, *MOTION_LABELS)  # PEAK_LABELS: signed, their change is p
 DRIVE_NAMES = {"actuator": "actuator F0 − k x", "history": "force history (the law's effort, open-loop)"}
 
 
-def crossing_ms(data, fraction):
-    """First time (ms) the moving contact reaches `fraction` of the stroke, linearly interpolated; nan if never."""
-    x, t = data["sensors/contact_displacement"], data["time"]
-    above = np.flatnonzero(x >= fraction * STROKE)
-    if not above.size:
-        return float("nan")
-    i = above[0]
-    return float(np.interp(fraction * STROKE, x[i - 1:i + 1], t[i - 1:i + 1])) * 1e3
-
-
 def motion(data):
-    t_10, t_90 = crossing_ms(data, 0.1), crossing_ms(data, 0.9)
-    return {"t_90": t_90, "mean_speed": 0.8 * STROKE / (t_90 - t_10) * 1e3,
+    return {"t_90": crossing_time(data, 0.9) * 1e3, "mean_speed": mean_speed(data),
             "v_peak": float(np.max(data["sensors/contact_velocity"])), "kinetic_max": float(np.max(data["energy/kinetic"]))}
 
 
 def peak_parts(data):
-    """(normal, friction) part of J's force on the moving contact along the stroke (+y), kN, at the sample of the
-    peak |a|: the force on the journal is −F_n n + F_t t, t = (−n_y, n_x), n along the eccentricity."""
+    """(normal, friction) part of J's force on the moving contact along the stroke (+y), kN, and the angle (deg)
+    between J's contact normal and the stroke, at the sample of the peak |a|: the force on the journal is
+    −F_n n + F_t t, t = (−n_y, n_x), n along the eccentricity."""
     i = int(np.argmax(np.abs(data["sensors/contact_acceleration"])))
     e = data["joints/J/eccentricity"][i]
     n = e / np.hypot(*e)
-    return -data["joints/J/normal_force"][i] * n[1] / 1e3, data["joints/J/friction_force"][i] * n[0] / 1e3
+    return (-data["joints/J/normal_force"][i] * n[1] / 1e3, data["joints/J/friction_force"][i] * n[0] / 1e3,
+            float(np.degrees(np.arccos(abs(n[1])))))
 
 
 def merit(path, ideal):
@@ -91,8 +81,8 @@ def merit(path, ideal):
     if figures is None:
         return None
     data = read_result(path)
-    normal, friction = peak_parts(data)
-    return {**figures, **motion(data), "peak_normal": normal, "peak_friction": friction}
+    normal, friction, angle = peak_parts(data)
+    return {**figures, **motion(data), "peak_normal": normal, "peak_friction": friction, "peak_angle": angle}
 
 
 def actuator_force(data, preload, stiffness, damping=0.0):
@@ -203,7 +193,11 @@ def print_peak_summary(figures):
     share = np.array([(f["peak_normal"] + f["peak_friction"]) * 1e3 / (MOVING_CONTACT_KG * f["peak"]) for f in runs])
     print(f"\n(the peak is at t = {times.min():.2f} … {times.max():.2f} ms; the same impact at μ_d 0.10 and 0.16 (times "
           f"within 0.1 ms) in {same} of {len(figures['0.10'])} samples; J's normal + friction force along the stroke "
-          f"there is {share.min() * 100:.0f} … {share.max() * 100:.0f} % of m·|a| of the moving contact)")
+          f"there is {share.min() * 100:.0f} … {share.max() * 100:.0f} % of m·|a| of the moving contact; J's contact "
+          f"normal is {min(f['peak_angle'] for f in runs):.0f} … {max(f['peak_angle'] for f in runs):.0f}° off the "
+          f"stroke, median {np.median([f['peak_angle'] for f in runs]):.0f}°)")
+    change = np.array([(b["peak"] / a["peak"] - 1) * 100 for a, b in zip(figures["0.10"], figures["0.16"])])
+    print(f"(μ_d 0.10 → 0.16, peak |a| per sample: {change.min():+.1f} … {change.max():+.1f} %)")
     change = {key: np.array([b[key] - a[key] for a, b in zip(figures["0.10"], figures["0.16"])])
               for key in ("peak_normal", "peak_friction")}
     mass_times_peak = np.array([(b["peak"] - a["peak"]) * MOVING_CONTACT_KG / 1e3 for a, b in zip(figures["0.10"], figures["0.16"])])

@@ -10,60 +10,26 @@ and 0.16 (journals centred) under the actuator and, for contrast, under the driv
 import numpy as np
 import pytest
 
-from tests.support.uhv_actuator import FORCE_DRIVE
+from tests.support.uhv_actuator import FORCE_DRIVE, crossing_time, mean_speed
 
 IDEAL = ("joints.A.clearance=0", "joints.J.clearance=0")
 CLEARANCE = ("joints.A.clearance=0.1mm", "joints.J.clearance=0.1mm")
-STROKE = 0.300  # m, the moving contact's stroke under the drive law (docs/uhv-geometry.md)
 
 
-@pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    """run(*overrides) → result of the bundled UHV model over the full 85 ms, memoised across the module."""
-    from clearsim.io.hdf5 import read_result
-    from clearsim.model.loader import load_mechanism
-    from clearsim.runner import BUNDLED_CONFIG, prepare, run_to_file
-
-    folder, done = tmp_path_factory.mktemp("force_drive"), {}
-
-    def run(*overrides):
-        if overrides not in done:
-            loaded = load_mechanism(BUNDLED_CONFIG, overrides)
-            output = folder / f"run{len(done)}.h5"
-            report = run_to_file(prepare(loaded), loaded, output)
-            assert report.complete, report.status
-            done[overrides] = read_result(output)
-        return done[overrides]
-
-    return run
-
-
-def crossing_time(result, fraction):
-    """First time the moving contact reaches `fraction` of the stroke (s), interpolated between samples."""
-    x, t = result["sensors/contact_displacement"], result["time"]
-    i = int(np.flatnonzero(x >= fraction * STROKE)[0])
-    return float(np.interp(fraction * STROKE, x[i - 1:i + 1], t[i - 1:i + 1]))
-
-
-def mean_speed(result):
-    """Mean speed of the moving contact between 10 % and 90 % of the stroke (m/s)."""
-    return 0.8 * STROKE / (crossing_time(result, 0.9) - crossing_time(result, 0.1))
-
-
-def test_the_calibrated_actuator_moves_the_ideal_mechanism_like_the_drive_law(runs):
-    actuated, law = runs(*FORCE_DRIVE, *IDEAL), runs(*IDEAL)
+def test_the_calibrated_actuator_moves_the_ideal_mechanism_like_the_drive_law(uhv_runs):
+    actuated, law = uhv_runs(*FORCE_DRIVE, *IDEAL), uhv_runs(*IDEAL)
     error = actuated["sensors/contact_displacement"] - law["sensors/contact_displacement"]
     assert np.sqrt(np.mean(error**2)) < 5e-3  # clearsim: 3.4 mm RMS over 0–85 ms (the least-squares residual)
     assert crossing_time(actuated, 0.9) == pytest.approx(crossing_time(law, 0.9), abs=1e-3)  # 66.74 vs 66.58 ms
     assert float(np.max(actuated["energy/friction_dissipated"])) == 0.0  # no clearance: friction does no work
 
 
-def test_with_a_force_drive_friction_slows_the_stroke_and_does_not_lower_the_peak(runs):
+def test_with_a_force_drive_friction_slows_the_stroke_and_does_not_lower_the_peak(uhv_runs):
     """μ_d 0.10 → 0.16 at A and J (0.1 mm): under the actuator the friction work comes out of the motion, the
     contact's mean speed falls and it reaches 90 % of the stroke later; under the drive law the motion stays the
     law's. The start-up peak acceleration does not fall by the paper's 17 % under either drive."""
-    force = [runs(*FORCE_DRIVE, *CLEARANCE, f"defaults.friction.mu_d={mu}") for mu in ("0.10", "0.16")]
-    law = [runs(*CLEARANCE, f"defaults.friction.mu_d={mu}") for mu in ("0.10", "0.16")]
+    force = [uhv_runs(*FORCE_DRIVE, *CLEARANCE, f"defaults.friction.mu_d={mu}") for mu in ("0.10", "0.16")]
+    law = [uhv_runs(*CLEARANCE, f"defaults.friction.mu_d={mu}") for mu in ("0.10", "0.16")]
     slowdown = {name: 1.0 - mean_speed(pair[1]) / mean_speed(pair[0]) for name, pair in (("force", force), ("law", law))}
     assert slowdown["force"] > 0.005, slowdown  # clearsim: 1.06 % (ensemble: 1.1 %, in every sample)
     assert abs(slowdown["law"]) < 0.25 * slowdown["force"], slowdown  # the law imposes the motion: 0.08 %

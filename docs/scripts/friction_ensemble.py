@@ -116,22 +116,22 @@ def quartiles(values):
     return np.percentile(values, [0, 25, 50, 75, 100])
 
 
-def print_distributions(figures, nominal):
+def print_distributions(figures, nominal, labels=LABELS, formats=FORMATS):
     """Median [25th–75th percentile] (min–max) over the samples of every figure, per μ_d, and the nominal run."""
     print("| figure | " + " | ".join(f"μ_d = {mu}: median [IQR] (min–max)" for mu in MU_D)
           + " | nominal run (journals centred), " + " / ".join(MU_D) + " |")
     print("|---|" + "---|" * (len(MU_D) + 1))
-    for key, label in LABELS.items():
+    for key, label in labels.items():
         cells = []
         for mu in MU_D:
             low, q1, median, q3, high = quartiles([f[key] for f in figures[mu]])
-            spec = FORMATS[key]
+            spec = formats[key]
             cells.append(f"{median:{spec}} [{q1:{spec}}–{q3:{spec}}] ({low:{spec}}–{high:{spec}})")
-        print(f"| {label} | " + " | ".join(cells) + " | " + " / ".join(format(nominal[mu][key], FORMATS[key]) for mu in MU_D)
+        print(f"| {label} | " + " | ".join(cells) + " | " + " / ".join(format(nominal[mu][key], formats[key]) for mu in MU_D)
               + " |")
 
 
-def print_paired(figures):
+def print_paired(figures, keys=PAIRED, labels=LABELS):
     """Change per sample (same perturbation, other μ_d): median change [IQR] and how many samples fall; the
     Wilcoxon signed-rank test's two-sided p of 'no change'."""
     from scipy.stats import wilcoxon
@@ -140,7 +140,7 @@ def print_paired(figures):
     print("\n| figure | " + " | ".join(f"μ_d {a} → {b}: median change [IQR], falls in, Wilcoxon p" for a, b in pairs)
           + " |")
     print("|---|" + "---|" * len(pairs))
-    for key in PAIRED:
+    for key in keys:
         cells = []
         for first, second in pairs:
             before = np.array([f[key] for f in figures[first]])
@@ -149,7 +149,7 @@ def print_paired(figures):
             _, q1, median, q3, _ = quartiles(change)
             p = wilcoxon(after, before).pvalue
             cells.append(f"{median:+.1f} % [{q1:+.1f}, {q3:+.1f}], {int(np.sum(change < 0))}/{len(change)}, p = {p:.2g}")
-        print(f"| {LABELS[key]} | " + " | ".join(cells) + " |")
+        print(f"| {labels[key]} | " + " | ".join(cells) + " |")
 
 
 def print_spread_vs_trend(figures):
@@ -181,9 +181,12 @@ def print_same_impact(figures):
           + " %)")
 
 
-def ensemble_figure(figures, nominal):
+FIGURE_KEYS = ("peak", "p99", "rms_dev", "friction_J", "x_end_mm", "v_end")  # peak_10ms: the same as peak in every run
+
+
+def ensemble_figure(figures, nominal, keys=FIGURE_KEYS, labels=LABELS, name="validation-paper-friction-ensemble.png",
+                    drive=""):
     figure, axes = new_figure(2, 3, (11.0, 6.4))
-    keys = ("peak", "p99", "rms_dev", "friction_J", "x_end_mm", "v_end")  # peak_10ms: the same as peak in every run
     x = np.array([float(mu) for mu in MU_D])
     rng = np.random.default_rng(0)
     for ax, key in zip(axes.flat, keys):
@@ -199,43 +202,56 @@ def ensemble_figure(figures, nominal):
             ax.plot([0.10, 0.16], [2815.4, 2326.6], "s--", color="tab:red", label="Meng et al. 2015 (text)")
         ax.set_xticks(x)
         ax.set_xlabel("μ_d at A and J")
-        ax.set_title(LABELS[key].replace("\\|", "|") + (" = peak in 0–10 ms" if key == "peak" else ""), fontsize=9)
+        ax.set_title(labels[key].replace("\\|", "|") + (" = peak in 0–10 ms" if key == "peak" else ""), fontsize=9)
         if key in ("peak", "peak_10ms", "p99", "rms_dev"):
             ax.set_ylim(0, None)
     axes[0, 0].legend(fontsize=6)
-    figure.suptitle(f"A and J at {CLEARANCE_MM} mm: {len(figures[MU_D[0]])} perturbed runs per μ_d "
+    figure.suptitle(f"{drive}A and J at {CLEARANCE_MM} mm: {len(figures[MU_D[0]])} perturbed runs per μ_d "
                     "(clearance ±1 %, c_e 0.9 ± 0.005, journal start |e| ≤ 0.5 c)", fontsize=9)
-    target = FIGURES / "validation-paper-friction-ensemble.png"
+    target = FIGURES / name
     figure.savefig(target, dpi=100)
     print(f"(wrote {target.relative_to(ROOT)})")
 
 
-def main():
-    arguments = sys.argv[1:]
+def command_line(arguments, default_folder):
+    """(OUT folder, created; samples N) from [OUT] [--samples N] [--…]."""
     samples = int(arguments[arguments.index("--samples") + 1]) if "--samples" in arguments else 20
     positional = [a for i, a in enumerate(arguments) if not a.startswith("--") and (i == 0 or arguments[i - 1] != "--samples")]
-    folder = Path(positional[0]) if positional else Path("/tmp/clearsim-friction-ensemble")
+    folder = Path(positional[0]) if positional else Path(default_folder)
     folder.mkdir(parents=True, exist_ok=True)
-    ideal = read_result(run_case(folder, "ideal", IDEAL))
+    return folder, samples
+
+
+def run_ensemble(folder, samples, base=(), merit=figures_of_merit):
+    """(ideal result, nominal merits per μ_d, sample merits per μ_d) of the ensemble; `base`: overrides put before
+    every case's own, the ideal one included. Every case's overrides go to OUT/cases.csv."""
+    ideal = read_result(run_case(folder, "ideal", (*base, *IDEAL)))
     nominal, figures = {}, {mu: [] for mu in MU_D}
     with open(folder / "cases.csv", "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(["case", "overrides"])
         for mu in MU_D:
             friction = f"defaults.friction.mu_d={mu}"
-            nominal[mu] = figures_of_merit(run_case(folder, f"nominal-mu{mu}", (*NOMINAL, friction)), ideal)
+            nominal[mu] = merit(run_case(folder, f"nominal-mu{mu}", (*base, *NOMINAL, friction)), ideal)
             for k in range(1, samples + 1):
-                name, overrides = f"sample-{k:02d}-mu{mu}", (friction, *draws(k))
+                name, overrides = f"sample-{k:02d}-mu{mu}", (*base, friction, *draws(k))
                 writer.writerow([name, " ".join(f'--set "{o}"' for o in overrides)])
-                merit = figures_of_merit(run_case(folder, name, overrides), ideal)
-                if merit is None:
+                figures_k = merit(run_case(folder, name, overrides), ideal)
+                if figures_k is None:
                     print(f"{name} did not complete: left out", file=sys.stderr)
                     continue
-                figures[mu].append(merit)
+                figures[mu].append(figures_k)
     if len({len(f) for f in figures.values()}) != 1:
         sys.exit("not every sample completed at every μ_d; the paired tables need all of them")
     print("Sample 1 at μ_d = 0.10: `clearsim run configs/uhv_breaker.yaml "
-          + " ".join(f'--set "{o}"' for o in ("defaults.friction.mu_d=0.10", *draws(1))) + "`\n")
+          + " ".join(f'--set "{o}"' for o in (*base, "defaults.friction.mu_d=0.10", *draws(1))) + "`\n")
+    return ideal, nominal, figures
+
+
+def main():
+    arguments = sys.argv[1:]
+    folder, samples = command_line(arguments, "/tmp/clearsim-friction-ensemble")
+    _, nominal, figures = run_ensemble(folder, samples)
     print_distributions(figures, nominal)
     print_paired(figures)
     print_spread_vs_trend(figures)

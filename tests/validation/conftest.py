@@ -27,3 +27,22 @@ def simulate(tmp_path):
         return read_result(output)
 
     return run
+
+
+@pytest.fixture(scope="module")
+def uhv_runs(tmp_path_factory):
+    """run(*overrides) → result of the bundled UHV model, memoised across the test module."""
+    from clearsim.runner import BUNDLED_CONFIG
+
+    folder, done = tmp_path_factory.mktemp("uhv"), {}
+
+    def run(*overrides):
+        if overrides not in done:
+            loaded = load_mechanism(BUNDLED_CONFIG, overrides)
+            output = folder / f"run{len(done)}.h5"
+            report = run_to_file(prepare(loaded), loaded, output)
+            assert report.complete, report.status
+            done[overrides] = read_result(output)
+        return done[overrides]
+
+    return run

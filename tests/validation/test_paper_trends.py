@@ -27,24 +27,9 @@ def onset_time(result):
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
+def runs(uhv_runs):
     """run(*overrides) → result of the bundled UHV model over the first 5 ms, memoised across the module."""
-    from clearsim.io.hdf5 import read_result
-    from clearsim.model.loader import load_mechanism
-    from clearsim.runner import BUNDLED_CONFIG, prepare, run_to_file
-
-    folder, done = tmp_path_factory.mktemp("paper_trends"), {}
-
-    def run(*overrides):
-        if overrides not in done:
-            loaded = load_mechanism(BUNDLED_CONFIG, (WINDOW, *overrides))
-            output = folder / f"run{len(done)}.h5"
-            report = run_to_file(prepare(loaded), loaded, output)
-            assert report.complete, report.status
-            done[overrides] = read_result(output)
-        return done[overrides]
-
-    return run
+    return lambda *overrides: uhv_runs(WINDOW, *overrides)
 
 
 def ideal(run):

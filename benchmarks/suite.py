@@ -182,6 +182,17 @@ def measure(case: Case, repeats: int, quick: bool, folder: Path) -> Measurement:
         _relative(peak, ref_peak), _relative(force, ref_force), repeats, memory)
 
 
+def crank_study(compare_case, measurements: list[Measurement], repeats: int, quick: bool, folder: Path) -> dict:
+    """compare_case(friction, clearsim's measurement, repeats, quick) for the slider-crank cases of this run
+
+    (both, measured now, if the run has neither)."""
+    names = ((False, "crank-frictionless"), (True, "crank-friction"))
+    mine = [(friction, m) for friction, name in names for m in measurements if m.case == name]
+    if not mine:
+        mine = [(friction, measure(next(c for c in CASES if c.name == name), repeats, quick, folder)) for friction, name in names]
+    return {"cases": [compare_case(friction, m, repeats, quick) for friction, m in mine]}
+
+
 CLEARSIM_LADDER = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7)  # rtol (atol = rtol/1000), loosest first
 
 

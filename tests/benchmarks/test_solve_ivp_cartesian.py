@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from benchmarks import solve_ivp_cartesian as cartesian
-from tests.support.slider_crank_minimal import FRICTION, FRICTIONLESS, simulate as minimal
+from tests.support.slider_crank_minimal import FRICTION, FRICTIONLESS
+from tests.support.slider_crank_minimal import simulate as minimal
 
 FIRST_EPISODE_END = 4e-4  # s: the first contact episode lasts from 0.227 to ~0.29 ms
 RTOL = 1e-10

@@ -97,7 +97,7 @@ def _ladders(document: dict) -> list[str]:
                 else:
                     lines.append(f"| {case['case']} | {tool} | {name} = {r[name]:g} | {r['wall_s']:.3f} s | {r['max_contact_force']:.1f} N "
                                  f"| {r['error_max_contact_force']:.1e} | {r['error_peak_acceleration']:.1e} |")
-    return lines
+    return lines if len(lines) > 2 else []
 
 
 def _scaling(document: dict) -> list[str]:

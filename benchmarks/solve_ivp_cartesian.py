@@ -98,7 +98,7 @@ def constraint_rate(p: Parameters, phi_q: np.ndarray, v) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Contact:
-    """The clearance joint at one state: penetration δ, its rate δ̇, normal n, sliding velocity v_t, arm of n."""
+    """The clearance joint at one state: penetration δ, its rate δ̇, normal n, sliding velocity v_t."""
     penetration: float
     rate: float
     normal: tuple
@@ -123,20 +123,20 @@ def contact_forces(p: Parameters, contact: Contact, impact_speed: float) -> tupl
     return fn, -friction_coefficient(p, contact.sliding) * fn
 
 
-def generalised_forces(p: Parameters, q, v, impact_speed: float) -> tuple[np.ndarray, float]:
+def generalised_forces(p: Parameters, q, v, impact_speed: float) -> np.ndarray:
     """Q of the contact force F = −F_n n + F_t t on the journal at J + R_J n and −F on the bearing at B + R_B n."""
     contact = contact_kinematics(p, q, v)
     out = np.zeros(COORDINATES)
     fn, ft = contact_forces(p, contact, impact_speed)
     if fn == 0.0:
-        return out, 0.0
+        return out
     nx, ny = contact.normal
     fx, fy = -fn * nx - ft * ny, -fn * ny + ft * nx
     arm_x = 0.5 * p.rod_length * math.cos(q[5]) + p.journal_radius * nx  # (J + R_J n) − G2
     arm_y = 0.5 * p.rod_length * math.sin(q[5]) + p.journal_radius * ny
     out[3:6] = fx, fy, arm_x * fy - arm_y * fx
     out[6:9] = -fx, -fy, -p.bearing_radius * (nx * fy - ny * fx)  # arm (B + R_B n) − G3 = R_B n
-    return out, fn
+    return out
 
 
 def accelerations(p: Parameters, mass: np.ndarray, t: float, y, impact_speed: float) -> np.ndarray:
@@ -149,7 +149,7 @@ def accelerations(p: Parameters, mass: np.ndarray, t: float, y, impact_speed: fl
     matrix[COORDINATES:, :COORDINATES] = phi_q
     stabilised = (gamma(p, q, v) - 2.0 * BAUMGARTE * constraint_rate(p, phi_q, v)
                   - BAUMGARTE**2 * constraints(p, t, q))
-    forces, _ = generalised_forces(p, q, v, impact_speed)
+    forces = generalised_forces(p, q, v, impact_speed)
     return np.linalg.solve(matrix, np.concatenate([forces, stabilised]))[:COORDINATES]
 
 
@@ -191,9 +191,13 @@ class CartesianResult:
     def normal_force(self, t: float) -> float:
         """F_n at time t from the dense output."""
         segment = self._segment(t)
-        y = segment.sol(t)
-        contact = contact_kinematics(self.parameters, y[:COORDINATES], y[COORDINATES:])
-        return contact_forces(self.parameters, contact, segment.impact_speed)[0]
+        return self._normal_forces(segment, [t])[0]
+
+    def _normal_forces(self, segment: Segment, times) -> list:
+        """F_n at `times` within one segment (its dense output called once for all of them)."""
+        p = self.parameters
+        return [contact_forces(p, contact_kinematics(p, y[:COORDINATES], y[COORDINATES:]), segment.impact_speed)[0]
+                for y in segment.sol(np.asarray(times, dtype=float)).T]
 
     def slider_acceleration(self, t: float) -> float:
         """ẍ3 at time t (the augmented system solved at the dense-output state)."""
@@ -208,10 +212,9 @@ class CartesianResult:
             ts = segment.sol.ts
             grid = np.unique(np.concatenate([np.linspace(ts[k], ts[k + 1], 9) for k in range(len(ts) - 1)]))
             grid = grid[(grid >= max(t0, segment.t0)) & (grid <= min(t1, segment.t1))]
-            for k, t in enumerate(grid):
-                force = self.normal_force(t)
+            for k, force in enumerate(self._normal_forces(segment, grid) if len(grid) else []):
                 if force > best:
-                    best, where, bracket = force, t, (grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)])
+                    best, where, bracket = force, grid[k], (grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)])
         if bracket is not None and bracket[1] > bracket[0]:
             refined = minimize_scalar(lambda t: -self.normal_force(t), bounds=bracket, method="bounded",
                                       options={"xatol": 1e-15})
@@ -272,7 +275,7 @@ def first_impact(p: Parameters, t_end: float, rtol: float, atol: float) -> dict:
     """Onset time, δ̇⁻ and peak normal force of the first contact episode (the run stopped at t_end)."""
     result = simulate(p, t_end, rtol, atol)
     onset, speed = result.onsets[0]
-    loss = result.onsets[1][0] if len(result.onsets) > 1 else t_end
+    loss = next(segment.t1 for segment in result.segments if segment.t0 == onset)  # the segment the onset starts
     force, when = result.max_contact_force(onset, loss)
     return {"onset_s": onset, "impact_speed": speed, "peak_normal_force": force, "peak_time_s": when}
 

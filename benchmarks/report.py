@@ -22,11 +22,17 @@ def _cases(document: dict) -> list[str]:
     return lines
 
 
+SIDE_BY_SIDE = (  # study key, tool, its setting, the prefix of the clearsim errors it is matched against
+    ("peer", "Exudyn 1.13.6", lambda r: f"RK44, h = {r['step_s']:g} s", "clearsim_"),
+    ("baseline", "solve_ivp minimal", lambda r: f"DOP853, rtol = {r['rtol']:g}", "clearsim_"),
+    ("baseline-cartesian", "solve_ivp Cartesian", lambda r: f"DOP853, rtol = {r['rtol']:g}", "clearsim_reference_"),
+)
+
+
 def _side_by_side(document: dict) -> list[str]:
     lines = ["| case | tool | setting | wall median [min, max] | error peak acc. | error max F_n | its wall / clearsim's |",
              "|" + "---|" * 7]
-    for key, tool, setting in (("peer", "Exudyn 1.13.6", lambda r: f"RK44, h = {r['step_s']:g} s"),
-                               ("baseline", "solve_ivp", lambda r: f"DOP853, rtol = {r['rtol']:g}")):
+    for key, tool, setting, prefix in SIDE_BY_SIDE:
         study = document.get(key) or {}
         for case in study.get("cases", []):
             m = case["matched"]
@@ -37,8 +43,32 @@ def _side_by_side(document: dict) -> list[str]:
                          f"{case['wall_max_s']:.3f}] | {m['error_peak_acceleration']:.1e} | {m['error_max_contact_force']:.1e} | "
                          f"**{case['ratio']:.1f}×** |")
             lines.append(f"| | clearsim | rtol = 1e-7 | {case['clearsim_wall_median_s']:.3f} s | "
-                         f"{case['clearsim_error_peak_acceleration']:.1e} | {case['clearsim_error_max_contact_force']:.1e} | 1 |")
+                         f"{case[prefix + 'error_peak_acceleration']:.1e} | {case[prefix + 'error_max_contact_force']:.1e} | 1 |")
+            s = case.get("settled") or {}
+            if "ratio" in s:  # a tighter rung from which on every rung is as accurate (errors not monotone)
+                lines.append(f"| | {tool} | {setting(s)} and tighter | {s['wall_median_s']:.3f} s [{s['wall_min_s']:.3f}, "
+                             f"{s['wall_max_s']:.3f}] | {s['error_peak_acceleration']:.1e} | {s['error_max_contact_force']:.1e} | "
+                             f"**{s['ratio']:.1f}×** |")
+                lines.append(f"| | clearsim | rtol = 1e-7 | {s['clearsim_wall_median_s']:.3f} s | | | 1 |")
     return lines
+
+
+def _cartesian_ladder(document: dict) -> list[str]:
+    lines = ["| case | rtol | wall (one run) | steps | RHS | contact events | max F_n | error acc. / F_n vs reference "
+             "| error acc. / F_n vs own rtol/100 | max \\|Φ\\| |", "|" + "---|" * 10]
+    for case in (document.get("baseline-cartesian") or {}).get("cases", []):
+        lines.append(f"| {case['case']} | clearsim 1e-7 | | | | | | {case['clearsim_reference_error_peak_acceleration']:.1e} / "
+                     f"{case['clearsim_reference_error_max_contact_force']:.1e} | {case['clearsim_error_peak_acceleration']:.1e} / "
+                     f"{case['clearsim_error_max_contact_force']:.1e} | |")
+        for r in case["rows"]:
+            if "failed" in r:
+                lines.append(f"| {case['case']} | {r['rtol']:g} | failed: {r['failed'][:70]} | | | | | | | |")
+                continue
+            lines.append(f"| {case['case']} | {r['rtol']:g} | {r['wall_s']:.3f} s | {r['steps']} | {r['rhs_evaluations']} | "
+                         f"{r['contact_events']} | {r['max_contact_force']:.1f} N | {r['error_peak_acceleration']:.1e} / "
+                         f"{r['error_max_contact_force']:.1e} | {r['self_error_peak_acceleration']:.1e} / "
+                         f"{r['self_error_max_contact_force']:.1e} | {r['constraint_drift']:.1e} |")
+    return lines if len(lines) > 2 else []
 
 
 def _at_peer_accuracy(document: dict) -> list[str]:
@@ -67,7 +97,7 @@ def _ladders(document: dict) -> list[str]:
                 else:
                     lines.append(f"| {case['case']} | {tool} | {name} = {r[name]:g} | {r['wall_s']:.3f} s | {r['max_contact_force']:.1f} N "
                                  f"| {r['error_max_contact_force']:.1e} | {r['error_peak_acceleration']:.1e} |")
-    return lines
+    return lines if len(lines) > 2 else []
 
 
 def _scaling(document: dict) -> list[str]:
@@ -84,7 +114,8 @@ def _scaling(document: dict) -> list[str]:
 
 
 def render(document: dict) -> str:
-    parts = [_cases(document), _side_by_side(document), _at_peer_accuracy(document), _ladders(document), _scaling(document)]
+    parts = [_cases(document), _side_by_side(document), _at_peer_accuracy(document), _ladders(document),
+             _cartesian_ladder(document), _scaling(document)]
     return "\n\n".join("\n".join(p) for p in parts if p) + "\n"
 
 

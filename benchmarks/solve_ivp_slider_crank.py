@@ -74,9 +74,6 @@ def compare_case(friction: bool, clearsim, repeats: int, quick: bool) -> dict:
 
 def baseline(quick: bool, folder, measurements, repeats: int = 1) -> dict:
     """Study entry for the harness: both slider-crank cases against their clearsim measurement."""
-    out = {"cases": []}
-    for friction, name in ((False, "crank-frictionless"), (True, "crank-friction")):
-        mine = next((m for m in measurements if m.case == name), None)
-        if mine is not None:
-            out["cases"].append(compare_case(friction, mine, repeats, quick))
-    return out
+    from benchmarks.suite import crank_study
+
+    return crank_study(compare_case, measurements, repeats, quick, folder)

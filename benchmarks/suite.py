@@ -4,6 +4,7 @@
     python -m benchmarks                       # every case, 5 repeats → benchmarks/results/latest.json
     python -m benchmarks --quick               # 1 repeat, short cases (a smoke test)
     python -m benchmarks --cases crank-friction,uhv-c0.1 --repeats 3
+    python -m benchmarks --cases baseline-cartesian --repeats 3   # the issue's solve_ivp baseline
     python -m benchmarks --compare benchmarks/results/session2.json
 """
 
@@ -182,6 +183,17 @@ def measure(case: Case, repeats: int, quick: bool, folder: Path) -> Measurement:
         _relative(peak, ref_peak), _relative(force, ref_force), repeats, memory)
 
 
+def crank_study(compare_case, measurements: list[Measurement], repeats: int, quick: bool, folder: Path) -> dict:
+    """compare_case(friction, clearsim's measurement, repeats, quick) for the slider-crank cases of this run
+
+    (both, measured now, if the run has neither)."""
+    names = ((False, "crank-frictionless"), (True, "crank-friction"))
+    mine = [(friction, m) for friction, name in names for m in measurements if m.case == name]
+    if not mine:
+        mine = [(friction, measure(next(c for c in CASES if c.name == name), repeats, quick, folder)) for friction, name in names]
+    return {"cases": [compare_case(friction, m, repeats, quick) for friction, m in mine]}
+
+
 CLEARSIM_LADDER = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7)  # rtol (atol = rtol/1000), loosest first
 
 
@@ -252,16 +264,24 @@ def table(measurements: list[Measurement], sweep: dict | None, previous: dict | 
     return out
 
 
+SIDE_BY_SIDE = (  # study key, tool, its setting, the prefix of the clearsim errors it is matched against
+    ("peer", "Exudyn (RK44, fixed step)", lambda r: f"h = {r['step_s']:g} s", "clearsim_"),
+    ("baseline", "solve_ivp minimal (DOP853, events)", lambda r: f"rtol = {r['rtol']:g}", "clearsim_"),
+    ("baseline-cartesian", "solve_ivp Cartesian (Baumgarte, events)", lambda r: f"rtol = {r['rtol']:g}",
+     "clearsim_reference_"),
+)
+
+
 def side_by_side(document: dict):
     """Peer and baseline rows at matched accuracy, with clearsim's in the same run."""
     from rich.markup import escape
     from rich.table import Table
 
-    out = Table(title="slider-crank side by side at matched max-contact-force accuracy (each vs its own 100× tighter run)")
+    out = Table(title="slider-crank side by side at matched accuracy (errors: Exudyn and solve_ivp minimal vs their own 100× "
+                      "tighter run; solve_ivp Cartesian and the clearsim row under it vs the minimal model at rtol 1e-12)")
     for column in ("case", "tool", "setting", "wall median [min, max]", "err peak acc.", "err max F_n", "its wall / clearsim's"):
         out.add_column(column, justify="left" if column in ("case", "tool") else "right")
-    for key, tool, setting in (("peer", "Exudyn (RK44, fixed step)", lambda r: f"h = {r['step_s']:g} s"),
-                               ("baseline", "solve_ivp (DOP853, events)", lambda r: f"rtol = {r['rtol']:g}")):
+    for key, tool, setting, prefix in SIDE_BY_SIDE:
         study = document.get(key)
         if study is None:
             continue
@@ -276,7 +296,36 @@ def side_by_side(document: dict):
             out.add_row(case["case"], tool, setting(matched), _wall(case), f"{matched['error_peak_acceleration']:.1e}",
                         f"{matched['error_max_contact_force']:.1e}", f"{case['ratio']:.1f}×")
             out.add_row("", "clearsim (this run)", "rtol = 1e-7", f"{case['clearsim_wall_median_s']:.3f} s",
-                        f"{case['clearsim_error_peak_acceleration']:.1e}", f"{case['clearsim_error_max_contact_force']:.1e}", "")
+                        f"{case[prefix + 'error_peak_acceleration']:.1e}", f"{case[prefix + 'error_max_contact_force']:.1e}", "")
+            settled = case.get("settled") or {}
+            if "ratio" in settled:  # a tighter rung from which on every rung is as accurate (errors not monotone)
+                out.add_row("", tool, setting(settled) + " and tighter", _wall(settled), f"{settled['error_peak_acceleration']:.1e}",
+                            f"{settled['error_max_contact_force']:.1e}", f"{settled['ratio']:.1f}×")
+                out.add_row("", "clearsim (this run)", "rtol = 1e-7", f"{settled['clearsim_wall_median_s']:.3f} s", "", "", "")
+    return out
+
+
+def cartesian_ladder(document: dict):
+    """The Cartesian baseline's rtol ladder: errors against the common reference and against its own rtol/100 run."""
+    from rich.table import Table
+
+    out = Table(title="solve_ivp Cartesian ladder (ref. = minimal model at rtol 1e-12; self = own run at rtol/100)")
+    for column in ("case", "rtol", "wall (one run)", "steps", "RHS", "contact events", "max F_n", "err acc. / F_n vs ref.",
+                   "err acc. / F_n vs self", "max |Φ|"):
+        out.add_column(column, justify="left" if column == "case" else "right")
+    for case in (document.get("baseline-cartesian") or {}).get("cases", []):
+        out.add_row(case["case"], "clearsim 1e-7", "", "", "", "", "",
+                    f"{case['clearsim_reference_error_peak_acceleration']:.1e} / {case['clearsim_reference_error_max_contact_force']:.1e}",
+                    f"{case['clearsim_error_peak_acceleration']:.1e} / {case['clearsim_error_max_contact_force']:.1e}", "")
+        for r in case["rows"]:
+            if "failed" in r:
+                out.add_row(case["case"], f"{r['rtol']:g}", f"failed: {r['failed'][:70]}", *[""] * 7)
+                continue
+            out.add_row(case["case"], f"{r['rtol']:g}", f"{r['wall_s']:.3f} s", f"{r['steps']}", f"{r['rhs_evaluations']}",
+                        f"{r['contact_events']}", f"{r['max_contact_force']:.1f} N",
+                        f"{r['error_peak_acceleration']:.1e} / {r['error_max_contact_force']:.1e}",
+                        f"{r['self_error_peak_acceleration']:.1e} / {r['self_error_max_contact_force']:.1e}",
+                        f"{r['constraint_drift']:.1e}")
     return out
 
 
@@ -301,9 +350,10 @@ def at_peer_accuracy(document: dict):
 
 
 def _studies() -> dict:
-    from benchmarks import exudyn_slider_crank, extras, scaling, solve_ivp_slider_crank
+    from benchmarks import exudyn_slider_crank, extras, scaling, solve_ivp_cartesian, solve_ivp_slider_crank
 
     return {"peer": exudyn_slider_crank.peer, "baseline": solve_ivp_slider_crank.baseline,
+            "baseline-cartesian": solve_ivp_cartesian.baseline,
             "compile": extras.compile_time, "memory": extras.memory, "scaling": scaling.scaling}
 
 
@@ -315,7 +365,7 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="1 repeat, shortened cases, short sweep and studies")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--cases", help="comma-separated names (default: all): " + ", ".join(c.name for c in CASES)
-                        + ", sweep-8, profile, peer, baseline, compile, memory, scaling")
+                        + ", sweep-8, profile, peer, baseline, baseline-cartesian, compile, memory, scaling")
     parser.add_argument("--json", type=Path, default=RESULTS / "latest.json")
     parser.add_argument("--compare", type=Path, help="an earlier JSON: wall-time ratios per case")
     args = parser.parse_args(argv)
@@ -358,9 +408,12 @@ def main(argv=None) -> int:
     if "scaling" in document and not args.quick:
         figure(document["scaling"])
     console.print(table(measurements, sweep, previous))
-    if "peer" in document or "baseline" in document:
+    if any(key in document for key, *_ in SIDE_BY_SIDE):
         console.print(side_by_side(document))
+    if "peer" in document:
         console.print(at_peer_accuracy(document))
+    if "baseline-cartesian" in document:
+        console.print(cartesian_ladder(document))
     for name in ("profile", "compile", "memory", "scaling"):
         if name in document:
             console.print(extras.describe(name, document[name]))

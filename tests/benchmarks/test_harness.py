@@ -14,7 +14,7 @@ from benchmarks.suite import Measurement, main
 @pytest.fixture(scope="module")
 def document(tmp_path_factory):
     out = tmp_path_factory.mktemp("bench") / "bench.json"
-    assert main(["--quick", "--cases", "crank-frictionless,baseline,peer", "--json", str(out)]) == 0
+    assert main(["--quick", "--cases", "crank-frictionless,baseline,baseline-cartesian,peer", "--json", str(out)]) == 0
     return json.loads(out.read_text())
 
 
@@ -36,6 +36,19 @@ def test_the_baseline_states_its_accuracy_and_its_ratio(document):
         assert complete <= set(row) or set(row) == {"rtol", "failed"}
     if case["matched"] is not None:
         assert case["ratio"] > 0.0 and case["wall_median_s"] > 0.0
+
+
+def test_the_cartesian_baseline_states_both_errors_and_its_ratio(document):
+    (case,) = document["baseline-cartesian"]["cases"]
+    assert case["case"] == "crank-frictionless" and case["reference"]["rtol"] == 1e-12
+    for row in case["rows"]:
+        assert {"error_max_contact_force", "error_peak_acceleration", "self_error_max_contact_force",
+                "self_error_peak_acceleration", "constraint_drift"} <= set(row) or set(row) == {"rtol", "failed"}
+    clearsim = [case["clearsim_reference_error_" + name] for name in ("max_contact_force", "peak_acceleration")]
+    if case["matched"] is not None:  # matched means as accurate as clearsim on both figures, against the same reference
+        assert case["matched"]["error_max_contact_force"] <= clearsim[0]
+        assert case["matched"]["error_peak_acceleration"] <= clearsim[1]
+        assert case["ratio"] == pytest.approx(case["wall_median_s"] / case["clearsim_wall_median_s"])
 
 
 def test_the_peer_runs_or_says_how_to_install_it(document):

@@ -262,7 +262,5 @@ def effective_mass(system, k, q):
     else:
         blocks, bodies = jacobian_blocks(system, q)
         response = constrained_response(blocks, bodies, minv, pair, np.zeros(m))[0]
-    mobility = 0.0
-    for i in range(n):  # not `pair @ response`: numba's dot is BLAS, whose set-up loads scipy.linalg (arrays.py)
-        mobility += pair[i] * response[i]
+    mobility = pair @ response
     return 1.0 / mobility if mobility > 0.0 else np.inf

@@ -9,7 +9,7 @@ and the joint involved, after every sample up to that point has been yielded.
 from __future__ import annotations
 
 import time as clock
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Callable, Iterator
 
 import numpy as np
@@ -43,6 +43,13 @@ class Chunk:
     kinetic: np.ndarray
     potential: np.ndarray
     violation: np.ndarray
+
+    @staticmethod
+    def joined(chunks: list["Chunk"]) -> "Chunk":
+        """One chunk holding the samples of consecutive chunks, in order."""
+        if len(chunks) == 1:
+            return chunks[0]
+        return Chunk(*(np.concatenate([getattr(c, f.name) for c in chunks]) for f in fields(Chunk)))
 
 
 @dataclass

@@ -105,6 +105,17 @@ def _has_unit(quantity) -> bool:
 
 def to_si(value: Any, kind: str) -> float:
     """The SI magnitude of `value`, which must be of physical kind `kind` (a key of DIMENSIONS)."""
+    if isinstance(value, str):  # a file's unit strings come back with every load of it (sweeps, diagnose)
+        return _string_to_si(value, kind)
+    return _to_si(value, kind)
+
+
+@lru_cache(maxsize=4096)
+def _string_to_si(value: str, kind: str) -> float:
+    return _to_si(value, kind)
+
+
+def _to_si(value: Any, kind: str) -> float:
     dimension = DIMENSIONS[kind]
     quantity = parse_quantity(value)
     if not _dimensionality(quantity) and not _has_unit(quantity):

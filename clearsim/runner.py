@@ -159,9 +159,12 @@ class Summary:
     sticking_share: dict[str, float]  # of the time in contact, per joint (files without /stick: absent)
 
 
+SUMMARY_JOINT_DATASETS = ("/normal_force", "/mode", "/stick")
+
+
 def summarize(path: Path) -> Summary:
     """The figures `clearsim run` prints, read back from a result file."""
-    data = read_result(path)
+    data = read_result(path, lambda name: name.startswith("sensors/") or name.endswith(SUMMARY_JOINT_DATASETS))
     output = _output_sensors(data["attrs"]["config_yaml"])
     peak = {}
     for role in ("velocity", "acceleration"):

@@ -9,6 +9,7 @@ file is never overwritten: it is first renamed to the next free `<stem>.<k>.h5`.
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Callable
 import datetime as dt
 import signal
 import threading
@@ -125,8 +126,9 @@ class NotAResultFile(ValueError):
     pass
 
 
-def read_result(path: Path) -> dict:
-    """All datasets (as arrays) and root attributes of a result file: {'attrs': {...}, 'time': …, 'bodies/x/q': …}."""
+def read_result(path: Path, wanted: Callable[[str], bool] | None = None) -> dict:
+    """All datasets (as arrays) and root attributes of a result file: {'attrs': {...}, 'time': …, 'bodies/x/q': …};
+    with `wanted`, only the datasets whose names it accepts (a summary need not hold a long run in memory)."""
     path = Path(path)
     try:
         handle = h5py.File(path, "r")
@@ -136,7 +138,11 @@ def read_result(path: Path) -> dict:
         if "clearsim_version" not in handle.attrs:
             raise NotAResultFile(f"{path} is not a clearsim result file (no clearsim_version attribute)")
         out = {"attrs": dict(handle.attrs)}
-        handle.visititems(lambda name, node: out.__setitem__(name, node[()]) if isinstance(node, h5py.Dataset) else None)
+        def keep(name, node):
+            if isinstance(node, h5py.Dataset) and (wanted is None or wanted(name)):
+                out[name] = node[()]
+
+        handle.visititems(keep)
         return out
 
 

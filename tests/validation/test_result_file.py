@@ -85,3 +85,22 @@ def test_an_existing_result_is_kept_as_a_numbered_backup(tmp_path):
     assert read_result(second.backup)["attrs"]["created"] == created
     third, _ = run(tmp_path)
     assert third.backup == tmp_path / "sc.2.h5"
+
+
+def test_a_selective_read_and_the_summary_agree_with_the_whole_file(tmp_path):
+    """read_result(path, wanted) returns exactly the accepted datasets, equal to a whole read; the summary
+    `clearsim run` prints (which reads only what it needs) equals the peaks of the whole file."""
+    from clearsim.runner import summarize
+
+    report, _ = run(tmp_path)
+    whole = read_result(report.output)
+    some = read_result(report.output, lambda name: name.startswith("sensors/"))
+    assert set(some) == {"attrs"} | {name for name in whole if name.startswith("sensors/")}
+    for name in set(some) - {"attrs"}:
+        assert np.array_equal(some[name], whole[name])
+    summary = summarize(report.output)
+    assert summary.peak_acceleration == ("slider_acceleration",
+                                         float(np.max(np.abs(whole["sensors/slider_acceleration"]))))
+    mode = whole["joints/slider_pin/mode"]
+    assert summary.contact_time_share["slider_pin"] == tuple(float(np.mean(mode == m)) for m in (0, 1, 2))
+    assert summary.peak_contact_force["slider_pin"] >= float(np.max(whole["joints/slider_pin/normal_force"]))

@@ -12,6 +12,7 @@ needs no recompilation.
 
 from __future__ import annotations
 
+import sys
 from collections import namedtuple
 
 from numba import njit, types
@@ -87,7 +88,33 @@ def _pack(fields):
 
 def for_kernels(arrays: SystemArrays) -> KernelArrays:
     """The arrays as every compiled kernel takes them (one compiled specialisation for all callers)."""
+    if not _numba_target_ready:
+        return _first_pack(tuple(arrays))
     return _pack(tuple(arrays))
+
+
+_numba_target_ready = False
+
+
+def _first_pack(fields) -> KernelArrays:
+    """_pack, the process's first kernel call, with scipy's BLAS hidden from numba.
+
+    The first kernel a process calls loads numba's CPU target, which checks for BLAS by importing
+    scipy.linalg.cython_blas: scipy.linalg and what it pulls in (numpy.testing, numpy.f2py, ...) cost 18 MB of
+    memory and ~0.1 s per process (run, sweep worker). No kernel here uses BLAS (no `@`, np.dot or np.linalg
+    inside a kernel), so numba is told there is none; scipy.linalg itself stays importable for everything else.
+    If scipy.linalg is already loaded (diagnose), there is nothing to save and nothing is hidden.
+    """
+    global _numba_target_ready
+    _numba_target_ready = True
+    name = "scipy.linalg.cython_blas"
+    if "scipy.linalg" in sys.modules or name in sys.modules:
+        return _pack(fields)
+    sys.modules[name] = None  # `import scipy.linalg.cython_blas` raises ImportError: numba records "no BLAS"
+    try:
+        return _pack(fields)
+    finally:
+        del sys.modules[name]
 
 
 @njit(cache=True, inline="always")

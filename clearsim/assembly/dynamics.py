@@ -262,5 +262,7 @@ def effective_mass(system, k, q):
     else:
         blocks, bodies = jacobian_blocks(system, q)
         response = constrained_response(blocks, bodies, minv, pair, np.zeros(m))[0]
-    mobility = pair @ response
+    mobility = 0.0
+    for i in range(n):  # not `pair @ response`: numba's dot is BLAS, whose set-up loads scipy.linalg (arrays.py)
+        mobility += pair[i] * response[i]
     return 1.0 / mobility if mobility > 0.0 else np.inf

@@ -32,7 +32,7 @@ def test_with_a_force_drive_friction_slows_the_stroke_and_does_not_lower_the_pea
     law = [uhv_runs(*CLEARANCE, f"defaults.friction.mu_d={mu}") for mu in ("0.10", "0.16")]
     slowdown = {name: 1.0 - mean_speed(pair[1]) / mean_speed(pair[0]) for name, pair in (("force", force), ("law", law))}
     assert slowdown["force"] > 0.005, slowdown  # clearsim: 1.06 % (ensemble: 1.1 %, in every sample)
-    assert abs(slowdown["law"]) < 0.25 * slowdown["force"], slowdown  # the law imposes the motion: 0.08 %
+    assert abs(slowdown["law"]) < 0.25 * slowdown["force"], slowdown  # the law imposes the motion: 0.02 %
     assert crossing_time(force[1], 0.9) > crossing_time(force[0], 0.9), [crossing_time(r, 0.9) for r in force]
     lost_kinetic = float(np.max(force[0]["energy/kinetic"]) - np.max(force[1]["energy/kinetic"]))
     assert lost_kinetic > 0.0, lost_kinetic  # clearsim: 20 J of 1192 J (under the law it rises by 4 J)

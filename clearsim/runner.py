@@ -90,9 +90,8 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
         pending = _PendingChunks(writer, episodes, system)
         try:
             run = Run(system)
-            pending.run = run
             for chunk in run.chunks():
-                pending.add(chunk)
+                pending.add(chunk, run)
                 if progress is not None:
                     progress(run.time)
         except SolverError as exc:
@@ -123,7 +122,8 @@ class _PendingChunks:
         self.initial_energy: float | None = None
         self.written_at = time.perf_counter()
 
-    def add(self, chunk) -> None:
+    def add(self, chunk, run: Run) -> None:
+        self.run = run  # its episode log classifies the modes at the flush
         if self.initial_energy is None:
             self.initial_energy = float(chunk.kinetic[0] + chunk.potential[0])
         self.items.append(chunk)

@@ -60,7 +60,6 @@ SystemArrays = namedtuple(
 )
 
 
-
 # --- the form the kernels take: one numba structref holding the arrays above -------------------------
 # A kernel called with the namedtuple receives 23 arrays (≈ 200 machine words) and takes and releases a
 # reference to each at every call; with the structref it receives one pointer. Same fields, same attribute

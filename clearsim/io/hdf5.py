@@ -9,10 +9,10 @@ file is never overwritten: it is first renamed to the next free `<stem>.<k>.h5`.
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable
 import datetime as dt
 import signal
 import threading
+from collections.abc import Callable
 from pathlib import Path
 
 import h5py
@@ -138,6 +138,7 @@ def read_result(path: Path, wanted: Callable[[str], bool] | None = None) -> dict
         if "clearsim_version" not in handle.attrs:
             raise NotAResultFile(f"{path} is not a clearsim result file (no clearsim_version attribute)")
         out = {"attrs": dict(handle.attrs)}
+
         def keep(name, node):
             if isinstance(node, h5py.Dataset) and (wanted is None or wanted(name)):
                 out[name] = node[()]

@@ -252,10 +252,9 @@ def peer(quick: bool, folder, measurements, repeats: int = 1) -> dict:
     """Study entry for the harness: the first-impact check, then each slider-crank case side by side."""
     if not available():
         return {"skipped": MISSING}
-    out = {"first_impact": first_impact_check(), "cases": []}
-    for friction, name in ((False, "crank-frictionless"), (True, "crank-friction")):
-        mine = next((m for m in measurements if m.case == name), None)
-        if mine is None:
-            continue
-        out["cases"].append(compare_case(friction, mine, repeats, quick, folder))
-    return out
+    from benchmarks.suite import crank_study
+
+    def compare(friction, clearsim, repeats, quick):
+        return compare_case(friction, clearsim, repeats, quick, folder)
+
+    return {"first_impact": first_impact_check(), **crank_study(compare, measurements, repeats, quick, folder)}

@@ -76,13 +76,18 @@ def error_norm(error, y, y_new, count, rtol, atol):
 
 @njit(cache=True)
 def interpolate(y, stages, h, theta, out):
-    """Continuous extension y(t + θh) into out."""
-    copy_into(out, y)
+    """Continuous extension y(t + θh) into out (one pass, no temporaries; each element sums its stages in order)."""
+    weights = np.empty(STAGES)
     for j in range(STAGES):
         weight = 0.0
         power = theta
         for p in range(4):
             weight += DENSE[j, p] * power
             power *= theta
-        if weight != 0.0:
-            out += h * weight * stages[j]
+        weights[j] = h * weight if weight != 0.0 else 0.0
+    for i in range(out.shape[0]):
+        value = y[i]
+        for j in range(STAGES):
+            if weights[j] != 0.0:
+                value += weights[j] * stages[j, i]
+        out[i] = value

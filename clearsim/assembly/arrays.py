@@ -15,6 +15,7 @@ from __future__ import annotations
 import sys
 from collections import namedtuple
 
+import numpy as np
 from numba import njit, types
 from numba.experimental import structref
 
@@ -77,7 +78,26 @@ class KernelArrays(structref.StructRefProxy):
     """SystemArrays as one reference-counted object for the kernels (built by `for_kernels`)."""
 
 
-structref.define_proxy(KernelArrays, KernelArraysType, list(SystemArrays._fields))
+# Scratch of the constrained solves (assembly/dynamics.py), sized once per system so that a solve allocates
+# nothing but its results: the small arrays numba would allocate, zero and free in every call cost a third of
+# a slider-crank's right-hand side. One solve uses them at a time (kernels run single-threaded, under the GIL),
+# and nothing a solve returns aliases them.
+WORKSPACE_FIELDS = [
+    "inverse_mass",  # (3 nb,) diagonal of M⁻¹: 1/m, 1/m, 1/J per body
+    "solve_blocks",  # (rows, 2, 3) Φ_q (and stick rows) in row blocks
+    "solve_bodies",  # (rows, 2) the bodies of each row block
+    "solve_schur",  # (rows, rows) S = Φ_q M⁻¹ Φ_qᵀ
+    "solve_lower",  # (rows, rows) its envelope Cholesky factor (only the envelope is written and read)
+    "solve_envelope",  # (rows,) first column of each row's envelope
+    "solve_body_start",  # (nb + 1,) the row blocks of body b are solve_entries[start[b]:start[b + 1]]
+    "solve_entries",  # (2 rows, 2) (row, slot) of each row block, grouped by body
+    "solve_body_fill",  # (nb,)
+    "solve_vector",  # (3 nb,) M⁻¹ f, then Φ_qᵀ λ
+    "solve_residual",  # (rows,)
+]
+
+
+structref.define_proxy(KernelArrays, KernelArraysType, list(SystemArrays._fields) + WORKSPACE_FIELDS)
 
 
 @njit(cache=True)
@@ -85,11 +105,25 @@ def _pack(fields):
     return KernelArrays(*fields)
 
 
+def _workspace(arrays: SystemArrays) -> tuple:
+    """WORKSPACE_FIELDS for a system: rows = its constraint rows + one stick row per clearance joint."""
+    bodies = arrays.mass.shape[0]
+    rows = 2 * arrays.pin_bodies.shape[0] + arrays.offset_bodies.shape[0] + arrays.angle_bodies.shape[0]
+    rows += arrays.clearance_bodies.shape[0]
+    with np.errstate(divide="ignore"):  # as the kernels divide: a zero mass or inertia gives inf, not a warning
+        inverse_mass = np.column_stack([1.0 / arrays.mass, 1.0 / arrays.mass, 1.0 / arrays.inertia]).ravel()
+    return (inverse_mass, np.zeros((rows, 2, 3)), np.zeros((rows, 2), np.int64), np.zeros((rows, rows)),
+            np.zeros((rows, rows)), np.zeros(rows, np.int64), np.zeros(bodies + 1, np.int64),
+            np.zeros((2 * rows, 2), np.int64), np.zeros(bodies, np.int64), np.zeros(3 * bodies), np.zeros(rows))
+
+
 def for_kernels(arrays: SystemArrays) -> KernelArrays:
-    """The arrays as every compiled kernel takes them (one compiled specialisation for all callers)."""
+    """The arrays as every compiled kernel takes them (one compiled specialisation for all callers), with the
+    scratch of their solves."""
+    fields = tuple(arrays) + _workspace(arrays)
     if not _numba_target_ready:
-        return _first_pack(tuple(arrays))
-    return _pack(tuple(arrays))
+        return _first_pack(fields)
+    return _pack(fields)
 
 
 _numba_target_ready = False

@@ -136,51 +136,59 @@ def evaluate_jacobian(system, q, jac):
 
 
 @njit(cache=True)
-def jacobian_times(blocks, bodies, x):
-    """Φ_q x."""
-    out = np.zeros(blocks.shape[0])
+def jacobian_times(blocks, bodies, x, out):
+    """out = Φ_q x."""
     for row in range(blocks.shape[0]):
+        out[row] = 0.0
         for slot in range(2):
             b = bodies[row, slot]
             if b >= 0:
                 out[row] += blocks[row, slot, 0] * x[3 * b] + blocks[row, slot, 1] * x[3 * b + 1] + blocks[row, slot, 2] * x[3 * b + 2]
-    return out
 
 
 @njit(cache=True)
-def jacobian_transpose_times(blocks, bodies, lam, n):
-    """Φ_qᵀ λ (length n)."""
-    out = np.zeros(n)
+def jacobian_transpose_times(blocks, bodies, lam, out):
+    """out = Φ_qᵀ λ."""
+    for i in range(out.shape[0]):
+        out[i] = 0.0
     for row in range(blocks.shape[0]):
         for slot in range(2):
             b = bodies[row, slot]
             if b >= 0:
                 for c in range(3):
                     out[3 * b + c] += blocks[row, slot, c] * lam[row]
-    return out
 
 
 @njit(cache=True)
-def schur_complement(blocks, bodies, minv):
-    """S = Φ_q M⁻¹ Φ_qᵀ from the blocks: rows couple only through a shared body, so S is summed body by body."""
+def schur_complement(system, blocks, bodies):
+    """S = Φ_q M⁻¹ Φ_qᵀ from the blocks, into system.solve_schur (its leading rows × rows): rows couple only
+    through a shared body, so S is summed body by body."""
     m = blocks.shape[0]
+    minv = system.inverse_mass
     nb = minv.shape[0] // 3
-    count = np.zeros(nb + 1, np.int64)
+    count = system.solve_body_start
+    for b in range(nb + 1):
+        count[b] = 0
     for row in range(m):
         for slot in range(2):
             if bodies[row, slot] >= 0:
                 count[bodies[row, slot] + 1] += 1
     for b in range(nb):
         count[b + 1] += count[b]
-    entries = np.empty((count[nb], 2), np.int64)  # (row, slot) of each block, grouped by body
-    filled = count[:nb].copy()
+    entries = system.solve_entries  # (row, slot) of each block, grouped by body
+    filled = system.solve_body_fill
+    for b in range(nb):
+        filled[b] = count[b]
     for row in range(m):
         for slot in range(2):
             b = bodies[row, slot]
             if b >= 0:
                 entries[filled[b], 0], entries[filled[b], 1] = row, slot
                 filled[b] += 1
-    schur = np.zeros((m, m))
+    schur = system.solve_schur
+    for i in range(m):
+        for j in range(m):
+            schur[i, j] = 0.0
     for b in range(nb):
         for e in range(count[b], count[b + 1]):
             i, si = entries[e, 0], entries[e, 1]

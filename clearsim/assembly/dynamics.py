@@ -17,7 +17,7 @@ from numba import njit
 
 from clearsim.assembly.constraints import (
     constraint_count, evaluate_acceleration_rhs, evaluate_constraints, evaluate_jacobian_blocks, evaluate_velocity_rhs,
-    jacobian_blocks, jacobian_times, jacobian_transpose_times, prescribed, schur_complement,
+    jacobian_times, jacobian_transpose_times, prescribed, schur_complement,
 )
 from clearsim.assembly.forces import (
     STICK, add_applied_forces, add_clearance_forces, add_global_force, clearance_kinematics, stick_row,
@@ -39,33 +39,22 @@ def coordinate_count(system):
 
 
 @njit(cache=True)
-def inverse_mass(system):
-    """Diagonal of M⁻¹."""
-    nb = system.mass.shape[0]
-    minv = np.empty(3 * nb)
-    for b in range(nb):
-        minv[3 * b] = 1.0 / system.mass[b]
-        minv[3 * b + 1] = 1.0 / system.mass[b]
-        minv[3 * b + 2] = 1.0 / system.inertia[b]
-    return minv
-
-
-@njit(cache=True)
-def cholesky_solve(matrix, rhs):
-    """Solve S x = b for symmetric positive definite S (small, dense); returns x (NaN if not SPD).
+def cholesky_solve(system, matrix, x):
+    """Solve S x = b in place (x holds b) for symmetric positive definite S (small, dense; NaN if not SPD).
 
     Envelope (skyline) Cholesky: row i of L starts where row i of S does (first[i]), since the
-    factor has no fill-in left of the envelope, so the zeros of a chain's S cost nothing.
+    factor has no fill-in left of the envelope, so the zeros of a chain's S cost nothing. L lives in
+    system.solve_lower, of which only the envelope is written and read.
     """
-    m = rhs.shape[0]
-    first = np.empty(m, np.int64)
+    m = x.shape[0]
+    first = system.solve_envelope
     for i in range(m):
         first[i] = i
         for j in range(i):
             if matrix[i, j] != 0.0:
                 first[i] = j
                 break
-    lower = np.zeros((m, m))
+    lower = system.solve_lower
     for i in range(m):
         for j in range(first[i], i + 1):
             acc = matrix[i, j]
@@ -73,11 +62,12 @@ def cholesky_solve(matrix, rhs):
                 acc -= lower[i, k] * lower[j, k]
             if i == j:
                 if acc <= 0.0:
-                    return np.full(m, np.nan)
+                    for r in range(m):
+                        x[r] = np.nan
+                    return
                 lower[i, i] = np.sqrt(acc)
             else:
                 lower[i, j] = acc / lower[j, j]
-    x = rhs.copy()
     for i in range(m):
         for k in range(first[i], i):
             x[i] -= lower[i, k] * x[k]
@@ -87,21 +77,39 @@ def cholesky_solve(matrix, rhs):
             if first[k] <= i:
                 x[i] -= lower[k, i] * x[k]
         x[i] /= lower[i, i]
-    return x
 
 
 @njit(cache=True)
-def constrained_response(blocks, bodies, minv, force, gamma):
+def constrained_response(system, blocks, bodies, force, gamma):
     """(a, λ) with a = M⁻¹ (f − Φ_qᵀ λ) and Φ_q a = γ."""
-    lam = cholesky_solve(schur_complement(blocks, bodies, minv), jacobian_times(blocks, bodies, minv * force) - gamma)
-    return minv * (force - jacobian_transpose_times(blocks, bodies, lam, force.shape[0])), lam
+    minv = system.inverse_mass
+    n = force.shape[0]
+    scaled = system.solve_vector
+    for i in range(n):
+        scaled[i] = minv[i] * force[i]
+    lam = np.empty(gamma.shape[0])
+    jacobian_times(blocks, bodies, scaled, lam)
+    for r in range(lam.shape[0]):
+        lam[r] -= gamma[r]
+    cholesky_solve(system, schur_complement(system, blocks, bodies), lam)
+    reaction = system.solve_vector
+    jacobian_transpose_times(blocks, bodies, lam, reaction)
+    a = np.empty(n)
+    for i in range(n):
+        a[i] = minv[i] * (force[i] - reaction[i])
+    return a, lam
 
 
 @njit(cache=True)
-def minimum_norm_correction(blocks, bodies, minv, residual, n):
-    """M⁻¹Φ_qᵀ S⁻¹ r: the smallest change (in the M metric) that removes a constraint residual r."""
-    lam = cholesky_solve(schur_complement(blocks, bodies, minv), residual)
-    return minv * jacobian_transpose_times(blocks, bodies, lam, n)
+def subtract_minimum_norm_correction(system, blocks, bodies, residual, x):
+    """x −= M⁻¹Φ_qᵀ S⁻¹ r: the smallest change (in the M metric) that removes a constraint residual r
+    (residual is overwritten)."""
+    cholesky_solve(system, schur_complement(system, blocks, bodies), residual)
+    correction = system.solve_vector
+    jacobian_transpose_times(blocks, bodies, residual, correction)
+    minv = system.inverse_mass
+    for i in range(x.shape[0]):
+        x[i] -= minv[i] * correction[i]
 
 
 @njit(cache=True)
@@ -125,14 +133,14 @@ def stick_row_index(system, modes, k):
 
 
 @njit(cache=True)
-def jacobian_with_sticks(system, q, qd, modes):
-    """(blocks, bodies, Ġq̇ of the stick rows): Φ_q with one row G per sticking joint appended."""
+def jacobian_with_sticks(system, q, qd, modes, curvature):
+    """(blocks, bodies) of Φ_q with one row G per sticking joint appended, views of the solve scratch;
+    Ġq̇ of the stick rows into curvature."""
     m = constraint_count(system)
     sticking = stick_count(modes)
-    blocks = np.empty((m + sticking, 2, 3))
-    bodies = np.empty((m + sticking, 2), np.int64)
+    blocks = system.solve_blocks[:m + sticking]
+    bodies = system.solve_bodies[:m + sticking]
     evaluate_jacobian_blocks(system, q, blocks, bodies)
-    curvature = np.zeros(sticking)
     row = m
     for k in range(modes.shape[0]):
         if modes[k] == STICK:
@@ -143,7 +151,17 @@ def jacobian_with_sticks(system, q, qd, modes):
                 blocks[row, 0, c] = bearing_block[c]
                 blocks[row, 1, c] = journal_block[c]
             row += 1
-    return blocks, bodies, curvature
+    return blocks, bodies
+
+
+@njit(cache=True)
+def scratch_jacobian(system, q):
+    """(blocks, bodies) of Φ_q at q, views of the solve scratch."""
+    m = constraint_count(system)
+    blocks = system.solve_blocks[:m]
+    bodies = system.solve_bodies[:m]
+    evaluate_jacobian_blocks(system, q, blocks, bodies)
+    return blocks, bodies
 
 
 @njit(cache=True)
@@ -151,15 +169,14 @@ def accelerations(system, t, q, qd, generalized, modes):
     """(q̈, λ) from M q̈ + Φ_qᵀ λ = Q, Φ_q q̈ = γ; λ ends with −F_t of each sticking joint."""
     m = constraint_count(system)
     sticking = stick_count(modes)
-    minv = inverse_mass(system)
     if m + sticking == 0:
-        return minv * generalized, np.zeros(0)
-    blocks, bodies, curvature = jacobian_with_sticks(system, q, qd, modes)
-    gamma = np.empty(m + sticking)
-    evaluate_acceleration_rhs(system, t, q, qd, gamma)
+        return system.inverse_mass * generalized, np.zeros(0)
+    gamma = system.solve_residual[:m + sticking]
+    blocks, bodies = jacobian_with_sticks(system, q, qd, modes, gamma[m:])
     for i in range(sticking):
-        gamma[m + i] = -curvature[i]
-    return constrained_response(blocks, bodies, minv, generalized, gamma)
+        gamma[m + i] = -gamma[m + i]
+    evaluate_acceleration_rhs(system, t, q, qd, gamma)
+    return constrained_response(system, blocks, bodies, generalized, gamma)
 
 
 @njit(cache=True)
@@ -202,23 +219,32 @@ def rhs(system, t, y, modes, impact_speeds, ydot):
     ydot[2 * n + WORK_APPLIED] = applied
 
 
+@njit(cache=True)
+def largest_magnitude(values):
+    """max |v_i| (0 for no values); np.max(np.abs(v)) without its temporary."""
+    largest = 0.0
+    for value in values:
+        magnitude = abs(value)
+        if magnitude > largest or magnitude != magnitude:  # NaN wins, as in np.max
+            largest = magnitude
+    return largest
+
+
 @njit(cache=True, inline="always")
 def project_positions(system, t, q, tolerance, max_iterations):
     """Newton projection of q onto Φ(q, t) = 0 in the M metric; returns the final max |Φ|."""
     m = constraint_count(system)
     if m == 0:
         return 0.0
-    n = q.shape[0]
-    minv = inverse_mass(system)
-    phi = np.empty(m)
+    phi = system.solve_residual[:m]
     for _ in range(max_iterations):
         evaluate_constraints(system, t, q, phi)
-        if np.max(np.abs(phi)) <= tolerance:
+        if largest_magnitude(phi) <= tolerance:
             break
-        blocks, bodies = jacobian_blocks(system, q)
-        q -= minimum_norm_correction(blocks, bodies, minv, phi, n)
+        blocks, bodies = scratch_jacobian(system, q)
+        subtract_minimum_norm_correction(system, blocks, bodies, phi, q)
     evaluate_constraints(system, t, q, phi)
-    return np.max(np.abs(phi))
+    return largest_magnitude(phi)
 
 
 @njit(cache=True, inline="always")
@@ -227,10 +253,14 @@ def project_velocities(system, t, q, qd, modes):
     m = constraint_count(system) + stick_count(modes)
     if m == 0:
         return
-    blocks, bodies, _ = jacobian_with_sticks(system, q, qd, modes)
+    residual = system.solve_residual[:m]
+    blocks, bodies = jacobian_with_sticks(system, q, qd, modes, residual[constraint_count(system):])
     nu = np.empty(m)
     evaluate_velocity_rhs(system, t, nu)
-    qd -= minimum_norm_correction(blocks, bodies, inverse_mass(system), jacobian_times(blocks, bodies, qd) - nu, q.shape[0])
+    jacobian_times(blocks, bodies, qd, residual)
+    for r in range(m):
+        residual[r] -= nu[r]
+    subtract_minimum_norm_correction(system, blocks, bodies, residual, qd)
 
 
 @njit(cache=True)
@@ -241,7 +271,7 @@ def constraint_violation(system, t, q):
         return 0.0
     phi = np.empty(m)
     evaluate_constraints(system, t, q, phi)
-    return np.max(np.abs(phi))
+    return largest_magnitude(phi)
 
 
 @njit(cache=True, inline="always")
@@ -255,13 +285,12 @@ def effective_mass(system, k, q):
     pair = np.zeros(n)
     add_global_force(pair, q, system.clearance_bodies[k, 1], bx + ex, by + ey, nx, ny)
     add_global_force(pair, q, system.clearance_bodies[k, 0], bx, by, -nx, -ny)
-    minv = inverse_mass(system)
     m = constraint_count(system)
     if m == 0:
-        response = minv * pair
+        response = system.inverse_mass * pair
     else:
-        blocks, bodies = jacobian_blocks(system, q)
-        response = constrained_response(blocks, bodies, minv, pair, np.zeros(m))[0]
+        blocks, bodies = scratch_jacobian(system, q)
+        response = constrained_response(system, blocks, bodies, pair, np.zeros(m))[0]
     mobility = 0.0
     for i in range(n):  # not `pair @ response`: numba's dot is BLAS, whose set-up loads scipy.linalg (arrays.py)
         mobility += pair[i] * response[i]

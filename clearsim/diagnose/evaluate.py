@@ -14,8 +14,8 @@ from pathlib import Path
 
 import h5py
 import numpy as np
-import yaml
 
+from clearsim.model.loader import dump_yaml
 from clearsim.sweep.worker import COMPLETE, CaseTask, run_case
 
 
@@ -33,7 +33,7 @@ class Prediction:
 
 
 def document_text(document: dict) -> str:
-    return yaml.safe_dump(document, sort_keys=False, allow_unicode=True)
+    return dump_yaml(document)
 
 
 def _read_sensors(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:

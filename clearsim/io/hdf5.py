@@ -67,16 +67,18 @@ class ResultWriter:
         for key, value in (attributes or {}).items():
             root[key] = value
         self.rows = 0
+        self.appended: dict[str, h5py.Dataset] = {}
 
     def _append(self, name: str, values: np.ndarray, unit: str) -> None:
         values = np.asarray(values)
-        if name not in self.file:
+        dataset = self.appended.get(name)  # kept open: a lookup by path costs as much as the write of a short run
+        if dataset is None:
             chunk_rows = max(1, min(4096, 2**20 // max(1, values[0].nbytes if values.ndim > 1 else 8)))
-            self.file.create_dataset(name, data=values, maxshape=(None, *values.shape[1:]),
-                                     chunks=(chunk_rows, *values.shape[1:]))
-            self.file[name].attrs["unit"] = unit
+            dataset = self.file.create_dataset(name, data=values, maxshape=(None, *values.shape[1:]),
+                                               chunks=(chunk_rows, *values.shape[1:]))
+            dataset.attrs["unit"] = unit
+            self.appended[name] = dataset
             return
-        dataset = self.file[name]
         start = dataset.shape[0]
         dataset.resize(start + values.shape[0], axis=0)
         dataset[start:] = values

@@ -29,6 +29,7 @@ from clearsim.model.schema import Mechanism
 
 MERGE_TAG = "tag:yaml.org,2002:merge"
 FAST_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when PyYAML has it: ~9× faster
+FAST_DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # the same text as SafeDumper (checked), 4× faster
 
 
 @dataclass
@@ -255,6 +256,11 @@ class LoadedMechanism:
     base_dir: Path  # relative file names (CSV tables) are read from here
 
 
+def dump_yaml(document: dict) -> str:
+    """A mechanism document as YAML text, keys in their order (the `config_yaml` of result files)."""
+    return yaml.dump(document, Dumper=FAST_DUMPER, sort_keys=False, allow_unicode=True)
+
+
 def load_mechanism(path: str | Path, overrides: Sequence[str] = ()) -> LoadedMechanism:
     """Read, override, validate and cross-check a mechanism file; InputError lists every problem."""
     path = Path(path)
@@ -279,5 +285,5 @@ def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[s
         problems += validation_problems(exc, document, Mechanism) + _references_of_valid_part(document, exc)
     if problems:
         raise InputError(problems, name, source)
-    resolved = yaml.safe_dump(document, sort_keys=False, allow_unicode=True)
+    resolved = dump_yaml(document)
     return LoadedMechanism(mechanism, Path(name), source, resolved, base_dir or Path.cwd())

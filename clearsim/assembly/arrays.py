@@ -94,6 +94,8 @@ WORKSPACE_FIELDS = [
     "solve_body_fill",  # (nb,)
     "solve_vector",  # (3 nb,) M⁻¹ f, then Φ_qᵀ λ
     "solve_residual",  # (rows,)
+    "factor_key",  # (1 + nc,) what solve_lower holds: none / positive definite / not; which joints have stick rows
+    "factor_q",  # (3 nb,) the q it was computed at
 ]
 
 
@@ -114,7 +116,8 @@ def _workspace(arrays: SystemArrays) -> tuple:
         inverse_mass = np.column_stack([1.0 / arrays.mass, 1.0 / arrays.mass, 1.0 / arrays.inertia]).ravel()
     return (inverse_mass, np.zeros((rows, 2, 3)), np.zeros((rows, 2), np.int64), np.zeros((rows, rows)),
             np.zeros((rows, rows)), np.zeros(rows, np.int64), np.zeros(bodies + 1, np.int64),
-            np.zeros((2 * rows, 2), np.int64), np.zeros(bodies, np.int64), np.zeros(3 * bodies), np.zeros(rows))
+            np.zeros((2 * rows, 2), np.int64), np.zeros(bodies, np.int64), np.zeros(3 * bodies), np.zeros(rows),
+            np.zeros(1 + arrays.clearance_bodies.shape[0], np.int64), np.zeros(3 * bodies))
 
 
 def for_kernels(arrays: SystemArrays) -> KernelArrays:

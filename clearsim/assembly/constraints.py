@@ -161,7 +161,7 @@ def jacobian_transpose_times(blocks, bodies, lam, out):
 
 @njit(cache=True)
 def schur_complement(system, blocks, bodies):
-    """S = Φ_q M⁻¹ Φ_qᵀ from the blocks, into system.solve_schur (its leading rows × rows): rows couple only
+    """S = Φ_q M⁻¹ Φ_qᵀ from the blocks into system.solve_schur (its leading rows × rows): rows couple only
     through a shared body, so S is summed body by body."""
     m = blocks.shape[0]
     minv = system.inverse_mass
@@ -200,7 +200,6 @@ def schur_complement(system, blocks, bodies):
                 schur[i, j] += total
                 if i != j:
                     schur[j, i] += total
-    return schur
 
 
 @njit(cache=True)

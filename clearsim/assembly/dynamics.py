@@ -32,6 +32,9 @@ WORK_DAMPING = 3
 WORK_APPLIED = 4
 WORK_COUNT = 5
 
+# factor_key[0]: what the scratch holds (factored_jacobian)
+FACTOR_NONE, FACTOR_SPD, FACTOR_SINGULAR = 0, 1, 2
+
 
 @njit(cache=True)
 def coordinate_count(system):
@@ -39,14 +42,14 @@ def coordinate_count(system):
 
 
 @njit(cache=True)
-def cholesky_solve(system, matrix, x):
-    """Solve S x = b in place (x holds b) for symmetric positive definite S (small, dense; NaN if not SPD).
+def factorize(system, m):
+    """Envelope (skyline) Cholesky factor of the symmetric m × m matrix S in system.solve_schur (small, dense)
+    into system.solve_lower; False if S is not positive definite.
 
-    Envelope (skyline) Cholesky: row i of L starts where row i of S does (first[i]), since the
-    factor has no fill-in left of the envelope, so the zeros of a chain's S cost nothing. L lives in
-    system.solve_lower, of which only the envelope is written and read.
+    Row i of L starts where row i of S does (first[i]), since the factor has no fill-in left of the
+    envelope, so the zeros of a chain's S cost nothing; only the envelope of solve_lower is written and read.
     """
-    m = x.shape[0]
+    matrix = system.solve_schur
     first = system.solve_envelope
     for i in range(m):
         first[i] = i
@@ -62,12 +65,23 @@ def cholesky_solve(system, matrix, x):
                 acc -= lower[i, k] * lower[j, k]
             if i == j:
                 if acc <= 0.0:
-                    for r in range(m):
-                        x[r] = np.nan
-                    return
+                    return False
                 lower[i, i] = np.sqrt(acc)
             else:
                 lower[i, j] = acc / lower[j, j]
+    return True
+
+
+@njit(cache=True)
+def solve_factored(system, x):
+    """x ← S⁻¹ x in place with the factor of the last factored_jacobian (NaN if S was not positive definite)."""
+    m = x.shape[0]
+    if system.factor_key[0] != FACTOR_SPD:
+        for r in range(m):
+            x[r] = np.nan
+        return
+    first = system.solve_envelope
+    lower = system.solve_lower
     for i in range(m):
         for k in range(first[i], i):
             x[i] -= lower[i, k] * x[k]
@@ -81,7 +95,7 @@ def cholesky_solve(system, matrix, x):
 
 @njit(cache=True)
 def constrained_response(system, blocks, bodies, force, gamma):
-    """(a, λ) with a = M⁻¹ (f − Φ_qᵀ λ) and Φ_q a = γ."""
+    """(a, λ) with a = M⁻¹ (f − Φ_qᵀ λ) and Φ_q a = γ, for the rows of the last factored_jacobian."""
     minv = system.inverse_mass
     n = force.shape[0]
     scaled = system.solve_vector
@@ -91,7 +105,7 @@ def constrained_response(system, blocks, bodies, force, gamma):
     jacobian_times(blocks, bodies, scaled, lam)
     for r in range(lam.shape[0]):
         lam[r] -= gamma[r]
-    cholesky_solve(system, schur_complement(system, blocks, bodies), lam)
+    solve_factored(system, lam)
     reaction = system.solve_vector
     jacobian_transpose_times(blocks, bodies, lam, reaction)
     a = np.empty(n)
@@ -102,9 +116,9 @@ def constrained_response(system, blocks, bodies, force, gamma):
 
 @njit(cache=True)
 def subtract_minimum_norm_correction(system, blocks, bodies, residual, x):
-    """x −= M⁻¹Φ_qᵀ S⁻¹ r: the smallest change (in the M metric) that removes a constraint residual r
-    (residual is overwritten)."""
-    cholesky_solve(system, schur_complement(system, blocks, bodies), residual)
+    """x −= M⁻¹Φ_qᵀ S⁻¹ r: the smallest change (in the M metric) that removes a constraint residual r, for the
+    rows of the last factored_jacobian (residual is overwritten)."""
+    solve_factored(system, residual)
     correction = system.solve_vector
     jacobian_transpose_times(blocks, bodies, residual, correction)
     minv = system.inverse_mass
@@ -133,34 +147,55 @@ def stick_row_index(system, modes, k):
 
 
 @njit(cache=True)
-def jacobian_with_sticks(system, q, qd, modes, curvature):
-    """(blocks, bodies) of Φ_q with one row G per sticking joint appended, views of the solve scratch;
-    Ġq̇ of the stick rows into curvature."""
-    m = constraint_count(system)
-    sticking = stick_count(modes)
-    blocks = system.solve_blocks[:m + sticking]
-    bodies = system.solve_bodies[:m + sticking]
-    evaluate_jacobian_blocks(system, q, blocks, bodies)
-    row = m
-    for k in range(modes.shape[0]):
-        if modes[k] == STICK:
-            bearing_block, journal_block, curvature[row - m] = stick_row(system, k, q, qd)
-            bodies[row, 0] = system.clearance_bodies[k, 0]
-            bodies[row, 1] = system.clearance_bodies[k, 1]
-            for c in range(3):
-                blocks[row, 0, c] = bearing_block[c]
-                blocks[row, 1, c] = journal_block[c]
-            row += 1
-    return blocks, bodies
+def _factor_matches(system, q, modes, with_sticks):
+    """The factor in the scratch is that of Φ_q at this q (bit for bit) with these stick rows."""
+    key = system.factor_key
+    if key[0] == FACTOR_NONE:
+        return False
+    for k in range(key.shape[0] - 1):
+        if key[1 + k] != (with_sticks and modes[k] == STICK):
+            return False
+    stored = system.factor_q
+    for i in range(q.shape[0]):
+        if stored[i] != q[i]:
+            return False
+    return True
 
 
 @njit(cache=True)
-def scratch_jacobian(system, q):
-    """(blocks, bodies) of Φ_q at q, views of the solve scratch."""
+def factored_jacobian(system, q, qd, modes, with_sticks, curvature):
+    """(blocks, bodies) of Φ_q at q, with one row G per sticking joint appended if with_sticks, as views of the
+    solve scratch, and S = Φ_q M⁻¹ Φ_qᵀ factorised there; Ġq̇ of the stick rows into curvature.
+
+    The rows depend on q alone (and on which joints stick), so a state's projection and its accelerations share
+    one factor: it is computed again only when q or the stick rows change (the key kept with it in the scratch;
+    every kernel that writes the scratch's rows comes through here).
+    """
     m = constraint_count(system)
-    blocks = system.solve_blocks[:m]
-    bodies = system.solve_bodies[:m]
-    evaluate_jacobian_blocks(system, q, blocks, bodies)
+    rows = m + (stick_count(modes) if with_sticks else 0)
+    blocks = system.solve_blocks[:rows]
+    bodies = system.solve_bodies[:rows]
+    fresh = not _factor_matches(system, q, modes, with_sticks)
+    if fresh:
+        evaluate_jacobian_blocks(system, q, blocks, bodies)
+    row = m
+    for k in range(system.factor_key.shape[0] - 1):
+        if with_sticks and modes[k] == STICK:
+            bearing_block, journal_block, curvature[row - m] = stick_row(system, k, q, qd)
+            if fresh:
+                bodies[row, 0] = system.clearance_bodies[k, 0]
+                bodies[row, 1] = system.clearance_bodies[k, 1]
+                for c in range(3):
+                    blocks[row, 0, c] = bearing_block[c]
+                    blocks[row, 1, c] = journal_block[c]
+            row += 1
+    if fresh:
+        key = system.factor_key
+        schur_complement(system, blocks, bodies)
+        key[0] = FACTOR_SPD if factorize(system, rows) else FACTOR_SINGULAR
+        for k in range(key.shape[0] - 1):
+            key[1 + k] = with_sticks and modes[k] == STICK
+        copy_into(system.factor_q, q)
     return blocks, bodies
 
 
@@ -172,7 +207,7 @@ def accelerations(system, t, q, qd, generalized, modes):
     if m + sticking == 0:
         return system.inverse_mass * generalized, np.zeros(0)
     gamma = system.solve_residual[:m + sticking]
-    blocks, bodies = jacobian_with_sticks(system, q, qd, modes, gamma[m:])
+    blocks, bodies = factored_jacobian(system, q, qd, modes, True, gamma[m:])
     for i in range(sticking):
         gamma[m + i] = -gamma[m + i]
     evaluate_acceleration_rhs(system, t, q, qd, gamma)
@@ -231,7 +266,7 @@ def largest_magnitude(values):
 
 
 @njit(cache=True, inline="always")
-def project_positions(system, t, q, tolerance, max_iterations):
+def project_positions(system, t, q, modes, tolerance, max_iterations):
     """Newton projection of q onto Φ(q, t) = 0 in the M metric; returns the final max |Φ|."""
     m = constraint_count(system)
     if m == 0:
@@ -241,7 +276,7 @@ def project_positions(system, t, q, tolerance, max_iterations):
         evaluate_constraints(system, t, q, phi)
         if largest_magnitude(phi) <= tolerance:
             break
-        blocks, bodies = scratch_jacobian(system, q)
+        blocks, bodies = factored_jacobian(system, q, q, modes, False, phi)
         subtract_minimum_norm_correction(system, blocks, bodies, phi, q)
     evaluate_constraints(system, t, q, phi)
     return largest_magnitude(phi)
@@ -254,7 +289,7 @@ def project_velocities(system, t, q, qd, modes):
     if m == 0:
         return
     residual = system.solve_residual[:m]
-    blocks, bodies = jacobian_with_sticks(system, q, qd, modes, residual[constraint_count(system):])
+    blocks, bodies = factored_jacobian(system, q, qd, modes, True, residual[constraint_count(system):])
     nu = np.empty(m)
     evaluate_velocity_rhs(system, t, nu)
     jacobian_times(blocks, bodies, qd, residual)
@@ -275,7 +310,7 @@ def constraint_violation(system, t, q):
 
 
 @njit(cache=True, inline="always")
-def effective_mass(system, k, q):
+def effective_mass(system, k, q, modes):
     """m_eff of clearance joint k along n: 1/(wᵀ P w), P the constrained mobility, w the unit force pair."""
     n = q.shape[0]
     zero = np.zeros(n)
@@ -289,7 +324,7 @@ def effective_mass(system, k, q):
     if m == 0:
         response = system.inverse_mass * pair
     else:
-        blocks, bodies = scratch_jacobian(system, q)
+        blocks, bodies = factored_jacobian(system, q, q, modes, False, pair)
         response = constrained_response(system, blocks, bodies, pair, np.zeros(m))[0]
     mobility = 0.0
     for i in range(n):  # not `pair @ response`: numba's dot is BLAS, whose set-up loads scipy.linalg (arrays.py)

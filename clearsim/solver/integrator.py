@@ -206,7 +206,7 @@ def earliest_event(system, t, y, y_new, stages, h, modes, speeds, scratch):
 def project_state(system, t, y, modes):
     """Project q and q̇ of y onto the constraint manifold (and v_t = 0 of sticking joints); returns max |Φ|."""
     n = coordinate_count(system)
-    violation = project_positions(system, t, y[:n], PROJECTION_TOLERANCE, 6)
+    violation = project_positions(system, t, y[:n], modes, PROJECTION_TOLERANCE, 6)
     project_velocities(system, t, y[:n], y[n:2 * n], modes)
     return violation
 
@@ -239,9 +239,9 @@ def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, rea
 
 
 @njit(cache=True, inline="always")
-def contact_time_step(system, k, q, speed):
+def contact_time_step(system, k, q, modes, speed):
     """Initial step into contact: the Hertz contact time t_c = 3.218 (m/K)^(2/5) v^(−1/5), over 20."""
-    mass = effective_mass(system, k, q)
+    mass = effective_mass(system, k, q, modes)
     stiffness = system.clearance_params[k, CL_STIFFNESS]
     exponent = system.clearance_params[k, CL_EXPONENT]
     v = max(speed, system.clearance_params[k, CL_MIN_IMPACT_SPEED])
@@ -297,7 +297,7 @@ def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_join
         ints[I_FRICTION_EVENTS] += 1
         return np.inf
     speed = speeds[k]
-    h, mass = contact_time_step(system, k, y[:n], speed)
+    h, mass = contact_time_step(system, k, y[:n], modes, speed)
     row = ints[I_LOG]
     log_joint[row] = k
     log_onset[row] = t
@@ -467,14 +467,14 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
         if event_joint >= 0:
             h = refine_event(system, event_joint, event_kind, t, y, f, event_theta * h, modes, speeds, stages,
                              y_new, ints)
-        else:
+        emit_samples(system, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
+                     out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
+        if event_joint < 0:  # projected after the samples: the step end's factor then serves its rhs below
             violation = project_state(system, t + h, y_new, modes)
             real[R_VIOLATION] = max(real[R_VIOLATION], violation)
             if violation > DRIFT_LIMIT:
                 ints[I_STATUS] = DRIFT
                 return
-        emit_samples(system, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
-                     out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
         update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch)
         copy_into(y, y_new)
         real[R_TIME] = t + h if h < real[R_T_END] - t else real[R_T_END]

@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 from clearsim.assembly.arrays import OFF_DIRECTION, OFF_POINT_I, OFF_POINT_J, OFF_VALUE
-from clearsim.assembly.kinematics import body_pose, body_rates, point_position, point_velocity, rotate
+from clearsim.assembly.kinematics import body_frame, body_pose, body_rates, frame_point, frame_rotate, frame_velocity
 from clearsim.physics.motion import evaluate_piecewise
 
 
@@ -30,22 +30,19 @@ def prescribed(system, law, t):
 
 
 @njit(cache=True)
-def _arms(q, bi, bj, p):
+def _arms(frame_i, frame_j, p):
     """A_i s_i and A_j s_j (global), the joint points of a row's parameters p = [s_i, s_j, …]."""
-    aix, aiy = rotate(body_pose(q, bi)[2], p[OFF_POINT_I], p[OFF_POINT_I + 1])
-    ajx, ajy = rotate(body_pose(q, bj)[2], p[OFF_POINT_J], p[OFF_POINT_J + 1])
+    aix, aiy = frame_rotate(frame_i, p[OFF_POINT_I], p[OFF_POINT_I + 1])
+    ajx, ajy = frame_rotate(frame_j, p[OFF_POINT_J], p[OFF_POINT_J + 1])
     return aix, aiy, ajx, ajy
 
 
 @njit(cache=True)
-def _offset_terms(system, k, q):
-    """w = A_i w̄ and d = P_j − P_i of offset row k."""
-    bi = system.offset_bodies[k, 0]
-    bj = system.offset_bodies[k, 1]
-    p = system.offset_params[k]
-    xi, yi = point_position(q, bi, p[OFF_POINT_I], p[OFF_POINT_I + 1])
-    xj, yj = point_position(q, bj, p[OFF_POINT_J], p[OFF_POINT_J + 1])
-    wx, wy = rotate(body_pose(q, bi)[2], p[OFF_DIRECTION], p[OFF_DIRECTION + 1])
+def _offset_terms(frame_i, frame_j, p):
+    """w = A_i w̄ and d = P_j − P_i of an offset row with parameters p."""
+    xi, yi = frame_point(frame_i, p[OFF_POINT_I], p[OFF_POINT_I + 1])
+    xj, yj = frame_point(frame_j, p[OFF_POINT_J], p[OFF_POINT_J + 1])
+    wx, wy = frame_rotate(frame_i, p[OFF_DIRECTION], p[OFF_DIRECTION + 1])
     return wx, wy, xj - xi, yj - yi
 
 
@@ -55,13 +52,15 @@ def evaluate_constraints(system, t, q, phi):
     row = 0
     for k in range(system.pin_bodies.shape[0]):
         s = system.pin_points[k]
-        xi, yi = point_position(q, system.pin_bodies[k, 0], s[0], s[1])
-        xj, yj = point_position(q, system.pin_bodies[k, 1], s[2], s[3])
+        xi, yi = frame_point(body_frame(q, system.pin_bodies[k, 0]), s[0], s[1])
+        xj, yj = frame_point(body_frame(q, system.pin_bodies[k, 1]), s[2], s[3])
         phi[row] = xi - xj
         phi[row + 1] = yi - yj
         row += 2
     for k in range(system.offset_bodies.shape[0]):
-        wx, wy, dx, dy = _offset_terms(system, k, q)
+        frame_i = body_frame(q, system.offset_bodies[k, 0])
+        frame_j = body_frame(q, system.offset_bodies[k, 1])
+        wx, wy, dx, dy = _offset_terms(frame_i, frame_j, system.offset_params[k])
         phi[row] = wx * dx + wy * dy - system.offset_params[k, OFF_VALUE] - prescribed(system, system.offset_law[k], t)[0]
         row += 1
     for k in range(system.angle_bodies.shape[0]):
@@ -82,7 +81,7 @@ def evaluate_jacobian_blocks(system, q, blocks, bodies):
     for k in range(system.pin_bodies.shape[0]):
         bi = system.pin_bodies[k, 0]
         bj = system.pin_bodies[k, 1]
-        aix, aiy, ajx, ajy = _arms(q, bi, bj, system.pin_points[k])
+        aix, aiy, ajx, ajy = _arms(body_frame(q, bi), body_frame(q, bj), system.pin_points[k])
         for axis in range(2):
             blocks[row + axis, 0, axis] = 1.0
             blocks[row + axis, 1, axis] = -1.0
@@ -95,8 +94,10 @@ def evaluate_jacobian_blocks(system, q, blocks, bodies):
     for k in range(system.offset_bodies.shape[0]):
         bi = system.offset_bodies[k, 0]
         bj = system.offset_bodies[k, 1]
-        wx, wy, dx, dy = _offset_terms(system, k, q)
-        aix, aiy, ajx, ajy = _arms(q, bi, bj, system.offset_params[k])
+        frame_i = body_frame(q, bi)
+        frame_j = body_frame(q, bj)
+        wx, wy, dx, dy = _offset_terms(frame_i, frame_j, system.offset_params[k])
+        aix, aiy, ajx, ajy = _arms(frame_i, frame_j, system.offset_params[k])
         bodies[row, 0], bodies[row, 1] = bi, bj
         blocks[row, 0, 0] = -wx
         blocks[row, 0, 1] = -wy
@@ -224,7 +225,7 @@ def evaluate_acceleration_rhs(system, t, q, qd, gamma):
         bj = system.pin_bodies[k, 1]
         wi = body_rates(qd, bi)[2]
         wj = body_rates(qd, bj)[2]
-        aix, aiy, ajx, ajy = _arms(q, bi, bj, system.pin_points[k])
+        aix, aiy, ajx, ajy = _arms(body_frame(q, bi), body_frame(q, bj), system.pin_points[k])
         gamma[row] = aix * wi * wi - ajx * wj * wj
         gamma[row + 1] = aiy * wi * wi - ajy * wj * wj
         row += 2
@@ -234,10 +235,12 @@ def evaluate_acceleration_rhs(system, t, q, qd, gamma):
         p = system.offset_params[k]
         wi = body_rates(qd, bi)[2]
         wj = body_rates(qd, bj)[2]
-        wx, wy, dx, dy = _offset_terms(system, k, q)
-        vix, viy = point_velocity(q, qd, bi, p[OFF_POINT_I], p[OFF_POINT_I + 1])
-        vjx, vjy = point_velocity(q, qd, bj, p[OFF_POINT_J], p[OFF_POINT_J + 1])
-        aix, aiy, ajx, ajy = _arms(q, bi, bj, p)
+        frame_i = body_frame(q, bi)
+        frame_j = body_frame(q, bj)
+        wx, wy, dx, dy = _offset_terms(frame_i, frame_j, p)
+        vix, viy = frame_velocity(frame_i, qd, bi, p[OFF_POINT_I], p[OFF_POINT_I + 1])
+        vjx, vjy = frame_velocity(frame_j, qd, bj, p[OFF_POINT_J], p[OFF_POINT_J + 1])
+        aix, aiy, ajx, ajy = _arms(frame_i, frame_j, p)
         centripetal = wx * (ajx * wj * wj - aix * wi * wi) + wy * (ajy * wj * wj - aiy * wi * wi)
         turning = wi * wi * (wx * dx + wy * dy) - 2.0 * wi * (-wy * (vjx - vix) + wx * (vjy - viy))
         gamma[row] = centripetal + turning + prescribed(system, system.offset_law[k], t)[2]

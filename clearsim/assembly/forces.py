@@ -19,7 +19,8 @@ from clearsim.assembly.arrays import (
     CL_V_HIGH, CL_V_LOW,
 )
 from clearsim.assembly.kinematics import (
-    GROUND, add_point_force, body_pose, body_rates, point_position, point_velocity, rotate,
+    GROUND, add_point_force, body_frame, body_pose, body_rates, frame_point, frame_rotate, frame_velocity,
+    point_position, point_velocity,
 )
 from clearsim.assembly.constraints import prescribed
 from clearsim.physics.contact import elastic_energy, elastic_force, normal_force
@@ -51,10 +52,12 @@ def clearance_kinematics(system, k, q, qd):
     p = system.clearance_params[k]
     bearing = system.clearance_bodies[k, 0]
     journal = system.clearance_bodies[k, 1]
-    bx, by = point_position(q, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
-    jx, jy = point_position(q, journal, p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
-    bvx, bvy = point_velocity(q, qd, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
-    jvx, jvy = point_velocity(q, qd, journal, p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
+    bearing_frame = body_frame(q, bearing)
+    journal_frame = body_frame(q, journal)
+    bx, by = frame_point(bearing_frame, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+    jx, jy = frame_point(journal_frame, p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
+    bvx, bvy = frame_velocity(bearing_frame, qd, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+    jvx, jvy = frame_velocity(journal_frame, qd, journal, p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
     ex, ey = jx - bx, jy - by
     dex, dey = jvx - bvx, jvy - bvy
     eccentricity = np.sqrt(ex * ex + ey * ey)
@@ -84,8 +87,8 @@ def stick_row(system, k, q, qd):
     journal = system.clearance_bodies[k, 1]
     ex, ey, dex, dey, _, rate, nx, ny, _ = clearance_kinematics(system, k, q, qd)
     tx, ty = -ny, nx
-    abx, aby = rotate(body_pose(q, bearing)[2], p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
-    ajx, ajy = rotate(body_pose(q, journal)[2], p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
+    abx, aby = frame_rotate(body_frame(q, bearing), p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+    ajx, ajy = frame_rotate(body_frame(q, journal), p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
     wb = body_rates(qd, bearing)[2]
     wj = body_rates(qd, journal)[2]
     eccentricity = np.sqrt(ex * ex + ey * ey)
@@ -174,10 +177,12 @@ def spring_state(system, k, q, qd):
     """(tension f = k(ℓ − ℓ0) + c ℓ̇ + preload, ℓ̇, u_x, u_y) of spring-damper k, u from point i to j."""
     p = system.spring_params[k]
     bi, bj = system.spring_bodies[k, 0], system.spring_bodies[k, 1]
-    xi, yi = point_position(q, bi, p[0], p[1])
-    xj, yj = point_position(q, bj, p[2], p[3])
-    vix, viy = point_velocity(q, qd, bi, p[0], p[1])
-    vjx, vjy = point_velocity(q, qd, bj, p[2], p[3])
+    frame_i = body_frame(q, bi)
+    frame_j = body_frame(q, bj)
+    xi, yi = frame_point(frame_i, p[0], p[1])
+    xj, yj = frame_point(frame_j, p[2], p[3])
+    vix, viy = frame_velocity(frame_i, qd, bi, p[0], p[1])
+    vjx, vjy = frame_velocity(frame_j, qd, bj, p[2], p[3])
     length = max(np.sqrt((xj - xi) ** 2 + (yj - yi) ** 2), 1e-300)
     ux, uy = (xj - xi) / length, (yj - yi) / length
     rate = ux * (vjx - vix) + uy * (vjy - viy)

@@ -30,28 +30,53 @@ def body_rates(qd, body):
 
 
 @njit(cache=True)
+def body_frame(q, body):
+    """(x, y, cos θ, sin θ) of a body, the ground at the origin and unrotated: each helper below takes it, so that a
+    kernel evaluating several points or rows of one body computes its cosine and sine once."""
+    if body == GROUND:
+        return 0.0, 0.0, 1.0, 0.0
+    angle = q[3 * body + 2]
+    return q[3 * body], q[3 * body + 1], np.cos(angle), np.sin(angle)
+
+
+@njit(cache=True)
+def frame_rotate(frame, sx, sy):
+    """A(θ) s."""
+    c, s = frame[2], frame[3]
+    return c * sx - s * sy, s * sx + c * sy
+
+
+@njit(cache=True)
+def frame_point(frame, sx, sy):
+    """r + A s: global position of a body-fixed point."""
+    ax, ay = frame_rotate(frame, sx, sy)
+    return frame[0] + ax, frame[1] + ay
+
+
+@njit(cache=True)
+def frame_velocity(frame, qd, body, sx, sy):
+    """ṙ + θ̇ B s: global velocity of a body-fixed point."""
+    vx, vy, omega = body_rates(qd, body)
+    ax, ay = frame_rotate(frame, sx, sy)
+    return vx - omega * ay, vy + omega * ax
+
+
+@njit(cache=True)
 def rotate(angle, sx, sy):
     """A(θ) s."""
-    c = np.cos(angle)
-    s = np.sin(angle)
-    return c * sx - s * sy, s * sx + c * sy
+    return frame_rotate((0.0, 0.0, np.cos(angle), np.sin(angle)), sx, sy)
 
 
 @njit(cache=True)
 def point_position(q, body, sx, sy):
     """r + A s: global position of a body-fixed point."""
-    x, y, angle = body_pose(q, body)
-    ax, ay = rotate(angle, sx, sy)
-    return x + ax, y + ay
+    return frame_point(body_frame(q, body), sx, sy)
 
 
 @njit(cache=True)
 def point_velocity(q, qd, body, sx, sy):
     """ṙ + θ̇ B s: global velocity of a body-fixed point."""
-    x, y, angle = body_pose(q, body)
-    vx, vy, omega = body_rates(qd, body)
-    ax, ay = rotate(angle, sx, sy)
-    return vx - omega * ay, vy + omega * ax
+    return frame_velocity(body_frame(q, body), qd, body, sx, sy)
 
 
 @njit(cache=True)

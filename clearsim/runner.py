@@ -8,7 +8,7 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
@@ -42,6 +42,7 @@ class RunReport:
     status: str
     statistics: object
     error: Exception | None = None
+    warnings: list[str] = field(default_factory=list)  # also the result file's `warnings` attribute, a line each
 
 
 def _attributes(system: System, loaded: LoadedMechanism) -> dict:
@@ -54,7 +55,7 @@ def _final_attributes(run: Run) -> dict:
     stats = run.statistics()
     return {"wall_time_s": stats.wall_time, "steps": stats.steps, "rejected_steps": stats.rejected_steps,
             "rhs_evaluations": stats.rhs_evaluations, "contact_events": stats.contact_events,
-            "max_step_violation": stats.max_violation, "simulated_time_s": run.time}
+            "max_step_violation": stats.max_violation, "simulated_time_s": run.time, "warnings": "\n".join(run.warnings())}
 
 
 def _write_episodes(writer: ResultWriter, system: System, run: Run, sample_episodes: np.ndarray) -> None:
@@ -104,7 +105,8 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
             if episodes:
                 _write_episodes(writer, system, run, np.concatenate(episodes))
             writer.finish(complete, status, _final_attributes(run) if run is not None else {})
-    return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error)
+    return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
+                     run.warnings() if run is not None else [])
 
 
 FLUSH_SECONDS = 0.5
@@ -157,6 +159,7 @@ class Summary:
     peak_contact_force: dict[str, float]
     contact_time_share: dict[str, tuple[float, float, float]]
     sticking_share: dict[str, float]  # of the time in contact, per joint (files without /stick: absent)
+    warnings: list[str] = field(default_factory=list)  # the file's `warnings` attribute, a line each
 
 
 SUMMARY_JOINT_DATASETS = ("/normal_force", "/mode", "/stick")
@@ -179,7 +182,8 @@ def summarize(path: Path) -> Summary:
         shares[j] = tuple(float(np.mean(mode == m)) if len(mode) else 0.0 for m in (0, 1, 2))
     sticking = {j: float(np.mean(data[f"joints/{j}/stick"][data[f"joints/{j}/mode"] > 0]))
                 for j in joints if f"joints/{j}/stick" in data and np.any(data[f"joints/{j}/mode"] > 0)}
-    return Summary(peak["velocity"], peak["acceleration"], forces, shares, sticking)
+    warnings = [line for line in str(data["attrs"].get("warnings", "")).split("\n") if line]
+    return Summary(peak["velocity"], peak["acceleration"], forces, shares, sticking, warnings)
 
 
 def _peak_contact_force(path: Path, joint: str, sampled: np.ndarray) -> float:

@@ -67,18 +67,18 @@ class ResultWriter:
         for key, value in (attributes or {}).items():
             root[key] = value
         self.rows = 0
-        self.appended: dict[str, h5py.Dataset] = {}
+        self.created: set[str] = set()
 
     def _append(self, name: str, values: np.ndarray, unit: str) -> None:
         values = np.asarray(values)
-        dataset = self.appended.get(name)  # kept open: a lookup by path costs as much as the write of a short run
-        if dataset is None:
+        if name not in self.created:  # a set, not `name in self.file`: the lookup by path costs as much as the write
             chunk_rows = max(1, min(4096, 2**20 // max(1, values[0].nbytes if values.ndim > 1 else 8)))
             dataset = self.file.create_dataset(name, data=values, maxshape=(None, *values.shape[1:]),
                                                chunks=(chunk_rows, *values.shape[1:]))
             dataset.attrs["unit"] = unit
-            self.appended[name] = dataset
+            self.created.add(name)
             return
+        dataset = self.file[name]  # not kept open: an open dataset holds its chunk cache (up to 1 MB) until closed
         start = dataset.shape[0]
         dataset.resize(start + values.shape[0], axis=0)
         dataset[start:] = values

@@ -93,6 +93,7 @@ def internal_contact_stiffness(
     return 4.0 / (3.0 * (sigma_bearing + sigma_journal)) * math.sqrt(effective_radius)
 
 
+@njit(cache=True)
 def hertz_max_penetration(effective_mass, stiffness, impact_speed, exponent=1.5):
     """δ_max from energy balance ½ m v² = K δ_max^{n+1}/(n+1); (5 m v²/(4K))^{2/5} for n = 1.5."""
     return ((exponent + 1.0) * effective_mass * impact_speed**2 / (2.0 * stiffness)) ** (

@@ -38,16 +38,19 @@ from clearsim.assembly.dynamics import (
 from clearsim.assembly.forces import (
     CONTACT, FREE, SLIDE_BACK, STICK, clearance_kinematics, contact_force_magnitudes, exact_stick,
 )
+from clearsim.physics.contact import hertz_max_penetration
 from clearsim.physics.friction import static_coefficient
 from clearsim.solver.dopri import STAGES, error_norm, interpolate, step
 from clearsim.solver.samples import derive_sample
 
 # real_state slots
-R_TIME, R_STEP, R_T_END, R_RTOL, R_ATOL, R_MAX_STEP, R_MIN_STEP, R_SAMPLE_DT, R_VIOLATION = range(9)
+(R_TIME, R_STEP, R_T_END, R_RTOL, R_ATOL, R_MAX_STEP, R_MIN_STEP, R_SAMPLE_DT, R_VIOLATION, R_COARSE_TIME,
+ R_COARSE_RATIO) = range(11)
+REAL_SLOTS = 11
 # int_state slots
 (I_STATUS, I_STEPS, I_REJECTED, I_RHS, I_EVENTS, I_SAMPLES, I_NEXT_SAMPLE, I_FAIL_JOINT, I_LOG, I_TOTAL_SAMPLES,
- I_FRICTION_EVENTS, I_STALLED) = range(12)
-INT_SLOTS = 12
+ I_FRICTION_EVENTS, I_STALLED, I_COARSE, I_COARSE_JOINT) = range(14)
+INT_SLOTS = 14
 
 RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END, CHATTER, FIRST_STEP = range(10)
 # FIRST_STEP: real[R_STEP] was 0 (no first step chosen), ẏ at the start is in f: choose it, call again
@@ -279,7 +282,21 @@ def settle_friction(system, k, t, y, modes, speeds, may_stick):
 
 
 @njit(cache=True, inline="always")
-def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_joint, log_onset, log_loss,
+def tolerance_over_penetration(system, k, y, mass, speed, rtol, atol):
+    """The error control's position tolerance at joint k's bodies over the Hertz penetration of the impact at its
+    onset: above 1 a step may err by more than the whole penetration, so the contact force is not resolved."""
+    p = system.clearance_params[k]
+    depth = hertz_max_penetration(mass, p[CL_STIFFNESS], max(speed, p[CL_MIN_IMPACT_SPEED]), p[CL_EXPONENT])
+    scale = 0.0
+    for slot in range(2):
+        body = system.clearance_bodies[k, slot]
+        if body >= 0:
+            scale = max(scale, abs(y[3 * body]), abs(y[3 * body + 1]))
+    return (atol + rtol * scale) / depth
+
+
+@njit(cache=True, inline="always")
+def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset, log_loss,
                 log_speed, log_mass):
     """Apply joint k's event at time t; returns the suggested next step."""
     if kind == NORMAL and modes[k] != FREE:  # contact lost
@@ -298,6 +315,13 @@ def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_join
         return np.inf
     speed = speeds[k]
     h, mass = contact_time_step(system, k, y[:n], modes, speed)
+    coarse = tolerance_over_penetration(system, k, y, mass, speed, real[R_RTOL], real[R_ATOL])
+    if coarse > 1.0:
+        if ints[I_COARSE] == 0:
+            ints[I_COARSE_JOINT] = k
+            real[R_COARSE_TIME] = t
+        ints[I_COARSE] += 1
+        real[R_COARSE_RATIO] = max(real[R_COARSE_RATIO], coarse)
     row = ints[I_LOG]
     log_joint[row] = k
     log_onset[row] = t
@@ -311,7 +335,7 @@ def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_join
 
 
 @njit(cache=True, inline="always")
-def consistent_modes(system, t, y, modes, speeds, episode_of, ints, log_joint, log_onset, log_loss,
+def consistent_modes(system, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset, log_loss,
                      log_speed, log_mass):
     """Switch joints whose mode disagrees with the state at the step start (initial state, restarts)."""
     h = np.inf
@@ -321,7 +345,7 @@ def consistent_modes(system, t, y, modes, speeds, episode_of, ints, log_joint, l
                 continue
             g = event_value(system, k, kind, t, y, modes, speeds)[0]
             if g > 0.0 if (kind == NORMAL and modes[k] == FREE) else g < 0.0:
-                h = min(h, switch_mode(system, k, kind, t, y, modes, speeds, episode_of, ints, log_joint,
+                h = min(h, switch_mode(system, k, kind, t, y, modes, speeds, episode_of, real, ints, log_joint,
                                        log_onset, log_loss, log_speed, log_mass))
     return h
 
@@ -434,7 +458,7 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
         if ints[I_LOG] >= log_joint.shape[0] - modes.shape[0] - 1:
             ints[I_STATUS] = BUFFER_FULL
             return
-        switched = consistent_modes(system, t, y, modes, speeds, episode_of, ints, log_joint, log_onset,
+        switched = consistent_modes(system, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset,
                                     log_loss, log_speed, log_mass)
         if switched < np.inf or ints[I_NEXT_SAMPLE] == 0:
             rhs(system, t, y, modes, speeds, f)
@@ -488,7 +512,8 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             ints[I_STATUS] = NOT_FINITE
             return
         if event_joint >= 0:
-            suggested = switch_mode(system, event_joint, event_kind, real[R_TIME], y, modes, speeds, episode_of, ints,
+            suggested = switch_mode(system, event_joint, event_kind, real[R_TIME], y, modes, speeds, episode_of, real,
+                                    ints,
                                     log_joint, log_onset, log_loss, log_speed, log_mass)
             real[R_STEP] = min(real[R_STEP], suggested)
         for k in range(modes.shape[0]):

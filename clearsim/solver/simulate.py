@@ -104,7 +104,7 @@ class Run:
         self.episode_of = np.full(nc, -1, np.int64)
         self.log = [np.zeros(LOG_CAPACITY, np.int64)] + [np.zeros(LOG_CAPACITY) for _ in range(4)]
         self.peak_force = np.zeros(nc)
-        self.real = np.zeros(9)
+        self.real = np.zeros(ig.REAL_SLOTS)
         self.ints = np.zeros(ig.INT_SLOTS, np.int64)
         dt = 1.0 / settings.output_rate
         self.real[[ig.R_T_END, ig.R_RTOL, ig.R_ATOL, ig.R_MAX_STEP, ig.R_MIN_STEP, ig.R_SAMPLE_DT]] = (
@@ -132,6 +132,19 @@ class Run:
             max_violation=float(self.real[ig.R_VIOLATION]), wall_time=self.wall_time,
             peak_normal_force=self.peak_force.copy(),
         )
+
+    def warnings(self) -> list[str]:
+        """What the run did but could not vouch for, in words (empty when nothing)."""
+        coarse = int(self.ints[ig.I_COARSE])
+        if coarse == 0:
+            return []
+        settings = self.system.mechanism.solver
+        joint = self.system.clearance_joints[int(self.ints[ig.I_COARSE_JOINT])]
+        return [f"{coarse} contact onset(s) not resolved by the solver tolerance (first: joint {joint} at "
+                f"t = {self.real[ig.R_COARSE_TIME] * 1e3:.4g} ms; the position tolerance, atol + rtol·|position| with "
+                f"rtol = {settings.rtol:g}, atol = {settings.atol:g} m, is up to {self.real[ig.R_COARSE_RATIO]:.3g}× the "
+                "impact's Hertz penetration): the contact forces of these impacts are not reliable; "
+                "tighten solver.rtol / solver.atol (the defaults are 1e-7 and 1e-10 m)"]
 
     def episode_log(self) -> EpisodeLog:
         count = int(self.ints[ig.I_LOG])

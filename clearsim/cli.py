@@ -121,7 +121,10 @@ def run(
     if report.backup is not None:
         console.print(f"kept the earlier result as {report.backup}")
     console.print(f"[bold]{system.mechanism.name}[/]: {report.status} → {report.output}")
-    console.print(_summary_table(report, summarize(report.output)))
+    summary = summarize(report.output)
+    console.print(_summary_table(report, summary))
+    for warning in summary.warnings:
+        errors.print(f"[bold yellow]warning:[/] {escape(warning)}", markup=True, highlight=False, soft_wrap=True)
     if isinstance(report.error, KeyboardInterrupt):
         raise KeyboardInterrupt
     if report.error is not None:

@@ -66,6 +66,7 @@ NORMAL, TANGENTIAL = 0, 1  # the two event functions of a clearance joint
 SLIDE_HYSTERESIS = 1e-9  # m/s: ε_v of the sliding-stops event, far below any resolved sliding speed
 DECIDE_SPEED = 1e-6  # m/s: below it a contact tests whether it sticks (settle_friction)
 DEEPEST_PENETRATION = 0.05  # of the journal radius: beyond it no contact law means anything
+UNRESOLVED_RATIO = 3.0  # position tolerance over an impact's Hertz penetration above which a run warns (model.md §4)
 
 
 @njit(cache=True)
@@ -316,12 +317,12 @@ def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, real, ints, lo
     speed = speeds[k]
     h, mass = contact_time_step(system, k, y[:n], modes, speed)
     coarse = tolerance_over_penetration(system, k, y, mass, speed, real[R_RTOL], real[R_ATOL])
-    if coarse > 1.0:
+    real[R_COARSE_RATIO] = max(real[R_COARSE_RATIO], coarse)
+    if coarse > UNRESOLVED_RATIO:
         if ints[I_COARSE] == 0:
             ints[I_COARSE_JOINT] = k
             real[R_COARSE_TIME] = t
         ints[I_COARSE] += 1
-        real[R_COARSE_RATIO] = max(real[R_COARSE_RATIO], coarse)
     row = ints[I_LOG]
     log_joint[row] = k
     log_onset[row] = t

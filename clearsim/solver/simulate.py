@@ -61,6 +61,7 @@ class Statistics:
     max_violation: float = 0.0
     wall_time: float = 0.0
     peak_normal_force: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    tolerance_over_penetration: float = 0.0  # largest over the contact onsets (docs/model.md §4)
 
 
 @dataclass
@@ -130,7 +131,7 @@ class Run:
             steps=int(self.ints[ig.I_STEPS]), rejected_steps=int(self.ints[ig.I_REJECTED]),
             rhs_evaluations=int(self.ints[ig.I_RHS]), contact_events=int(self.ints[ig.I_EVENTS]),
             max_violation=float(self.real[ig.R_VIOLATION]), wall_time=self.wall_time,
-            peak_normal_force=self.peak_force.copy(),
+            peak_normal_force=self.peak_force.copy(), tolerance_over_penetration=float(self.real[ig.R_COARSE_RATIO]),
         )
 
     def warnings(self) -> list[str]:
@@ -143,7 +144,8 @@ class Run:
         return [f"{coarse} contact onset(s) not resolved by the solver tolerance (first: joint {joint} at "
                 f"t = {self.real[ig.R_COARSE_TIME] * 1e3:.4g} ms; the position tolerance, atol + rtol·|position| with "
                 f"rtol = {settings.rtol:g}, atol = {settings.atol:g} m, is up to {self.real[ig.R_COARSE_RATIO]:.3g}× the "
-                "impact's Hertz penetration): the contact forces of these impacts are not reliable; "
+                f"impact's Hertz penetration, more than {ig.UNRESOLVED_RATIO:g}×): the contact forces of these impacts are "
+                "not reliable; "
                 "tighten solver.rtol / solver.atol (the defaults are 1e-7 and 1e-10 m)"]
 
     def episode_log(self) -> EpisodeLog:

@@ -32,6 +32,7 @@ class CaseRecord:
     steps: int = 0
     rejected_steps: int = 0
     wall_time: float = NAN
+    warnings: str = ""  # the result file's `warnings` attribute
 
 
 def _sensor(data: dict, name: str | None) -> np.ndarray | None:
@@ -51,7 +52,7 @@ def read_record(path: Path, output) -> CaseRecord:
         velocity=_sensor(data, output.velocity), displacement=_sensor(data, output.displacement),
         peak_acceleration=summary.peak_acceleration[1] if summary.peak_acceleration else NAN,
         contact=contact, steps=int(attrs.get("steps", 0)), rejected_steps=int(attrs.get("rejected_steps", 0)),
-        wall_time=float(attrs.get("wall_time_s", NAN)))
+        wall_time=float(attrs.get("wall_time_s", NAN)), warnings=" ".join(summary.warnings))
 
 
 def start_time(time: np.ndarray, velocity: np.ndarray, threshold: float, sign: float) -> float:

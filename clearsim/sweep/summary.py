@@ -17,7 +17,7 @@ PERCENTILES_FILE = "percentiles.csv"
 PERCENTILES = (5, 25, 50, 75, 95)
 FIGURES = ("peak_acceleration_m_s2", "acceleration_ratio", "start_delay_ms", "end_error_percent")
 JOINT_FIGURES = ("max_contact_force_N", "free_percent", "impact_percent", "contact_percent")
-TAIL = ("steps", "rejected_steps", "wall_time_s", "reused", "error")
+TAIL = ("steps", "rejected_steps", "wall_time_s", "reused", "error", "warnings")
 
 
 def joint_column(figure: str, joint: str) -> str:
@@ -54,7 +54,7 @@ def case_row(plan: SweepPlan, name: str, outcomes: dict[str, CaseOutcome], joint
     if record is None:
         return row
     row.update({"steps": record.steps, "rejected_steps": record.rejected_steps, "wall_time_s": record.wall_time,
-                "reused": "yes" if not outcome.ran else "no"})
+                "reused": "yes" if not outcome.ran else "no", "warnings": record.warnings})
     if record.complete:
         reference = outcomes.get(case.reference) if case.reference else None
         ideal = reference.record if reference is not None else (record if case.ideal else None)

@@ -40,6 +40,13 @@ def test_run_writes_the_file_and_prints_the_summary(tmp_path):
         assert bool(f.attrs["complete"]) and f["time"][-1] == pytest.approx(0.002)
 
 
+def test_run_prints_the_warning_of_an_unresolved_contact_and_exits_0(tmp_path):
+    out = tmp_path / "coarse.h5"
+    result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.rtol=1e-4", "--set", "solver.atol=1e-7")
+    assert result.exit_code == 0, result.output
+    assert "warning:" in result.output and "not resolved by the solver tolerance" in result.output
+
+
 def test_rerun_keeps_the_earlier_result(tmp_path):
     out = tmp_path / "sc.h5"
     for _ in range(2):

@@ -110,6 +110,7 @@ def run(
     overrides: List[str] = SetOption,
 ) -> None:
     """Simulate a mechanism and write its time histories to an HDF5 file."""
+    from clearsim.io.hdf5 import ResultWriteError
     from clearsim.runner import BUNDLED_CONFIG, prepare, run_to_file, summarize
     from clearsim.model.loader import load_mechanism
 
@@ -120,6 +121,8 @@ def run(
         report = run_to_file(system, loaded, output, update)
     if report.backup is not None:
         console.print(f"kept the earlier result as {report.backup}")
+    if isinstance(report.error, ResultWriteError):
+        raise report.error  # the file may not even be readable: nothing to summarise
     console.print(f"[bold]{system.mechanism.name}[/]: {report.status} → {report.output}")
     summary = summarize(report.output)
     console.print(_summary_table(report, summary))

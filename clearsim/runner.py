@@ -17,7 +17,9 @@ import numpy as np
 from clearsim.assembly.build import BuildError
 from clearsim.assembly.system import System, assemble
 from clearsim.errors import InputError, SolverError
-from clearsim.io.hdf5 import ResultWriter, group_attribute, interrupts_deferred, keep_existing, read_result
+from clearsim.io.hdf5 import (
+    ResultWriter, check_free_space, group_attribute, interrupts_deferred, keep_existing, read_result, write_failure,
+)
 from clearsim.model.loader import LoadedMechanism, load_mechanism
 from clearsim.solver.outputs import classify_episodes, chunk_outputs, sample_modes
 from clearsim.solver.simulate import Chunk, Run, Statistics
@@ -85,6 +87,7 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     computed is written when the run ends, fails or is interrupted.
     """
     output = Path(output)
+    check_free_space(output, result_file_bytes(system))
     backup = keep_existing(output)
     run = None  # made inside the try: loading the compiled kernels can take seconds, and may be interrupted
     episodes, status, complete, error = [], "complete", True, None
@@ -101,13 +104,32 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
         except KeyboardInterrupt as exc:
             at = run.time if run is not None else 0.0
             status, complete, error = f"interrupted at t = {at * 1e3:.3f} ms", False, exc
+        except OSError as exc:  # the disk filled up or went away mid-run
+            error = write_failure(output, exc)
+            status, complete = f"failed: {error}", False
         finally:
-            pending.flush()
-            if episodes:
-                _write_episodes(writer, system, run, np.concatenate(episodes))
-            writer.finish(complete, status, _final_attributes(run) if run is not None else {})
+            try:
+                pending.flush()
+                if episodes:
+                    _write_episodes(writer, system, run, np.concatenate(episodes))
+            except OSError as exc:
+                error = write_failure(output, exc)
+                status, complete = f"failed: {error}", False
+            try:  # whatever failed above, the file is flagged as far as it can still be written
+                writer.finish(complete, status, _final_attributes(run) if run is not None else {})
+            except OSError as exc:
+                error, complete = write_failure(output, exc), False
     return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
                      run.warnings() if run is not None else [])
+
+
+def result_file_bytes(system: System) -> float:
+    """An upper estimate of the result file's size: the datasets of DESIGN.md §6 at 8 bytes a value, 20 % over."""
+    settings = system.mechanism.solver
+    samples = settings.t_end * settings.output_rate + 1
+    per_sample = (1 + 9 * len(system.body_names) + 2 * (len(system.pin_joints) + len(system.prismatic_joints))
+                  + 8 * len(system.clearance_joints) + len(system.drivers) + len(system.sensors) + 9)
+    return 1.2 * 8 * per_sample * samples + 2**20
 
 
 FLUSH_SECONDS = 0.5

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import contextlib
 import datetime as dt
+import errno
+import shutil
 import signal
 import threading
 from collections.abc import Callable
@@ -19,6 +21,9 @@ import h5py
 import numpy as np
 
 from clearsim import __version__
+from clearsim.errors import ClearsimError
+
+WRITE_HINT = "check that the folder exists and can be written, or choose another file with -o"
 
 
 def keep_existing(path: Path) -> Path | None:
@@ -51,13 +56,51 @@ def interrupts_deferred():
             raise KeyboardInterrupt
 
 
+class ResultWriteError(ClearsimError):
+    """The result file cannot be written (no such folder, no permission, disk full); says where and why."""
+
+    def __init__(self, path: Path, reason: str, hint: str = WRITE_HINT):
+        self.path, self.reason, self.hint = Path(path), reason, hint
+        super().__init__(str(self))
+
+    def __str__(self) -> str:
+        return f"cannot write the result file {self.path}: {self.reason}. {self.hint}"
+
+
+def write_failure(path: Path, exc: OSError) -> ResultWriteError:
+    """The OSError of a write (Python's or libhdf5's) as a ResultWriteError naming the file."""
+    reason = exc.strerror or str(exc)
+    if "No space left" in str(exc) or getattr(exc, "errno", None) == errno.ENOSPC:
+        return ResultWriteError(path, "the disk is full", "free some space or write elsewhere with -o; the file keeps "
+                                "what was written before, flagged incomplete if it could still be closed")
+    return ResultWriteError(path, reason)
+
+
+def check_free_space(path: Path, needed_bytes: float) -> None:
+    """Make the folder of `path`; ResultWriteError, before anything is written, when it cannot be made or has less
+    free space than needed."""
+    folder = Path(path).parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        free = shutil.disk_usage(folder).free
+    except OSError as exc:
+        raise write_failure(path, exc) from None
+    if free < needed_bytes:
+        raise ResultWriteError(path, f"the run writes about {needed_bytes / 2**20:.0f} MB and {folder} has "
+                               f"{free / 2**20:.0f} MB free",
+                               "free some space, write elsewhere with -o, or lower solver.output_rate or solver.t_end")
+
+
 class ResultWriter:
     """Append-only writer of one run's result file."""
 
     def __init__(self, path: Path, config_yaml: str, attributes: dict | None = None):
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.file = h5py.File(self.path, "w")
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.file = h5py.File(self.path, "w")
+        except OSError as exc:
+            raise write_failure(self.path, exc) from None
         root = self.file.attrs
         root["clearsim_version"] = __version__
         root["created"] = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
@@ -121,7 +164,10 @@ class ResultWriter:
 
     def __exit__(self, *exc):
         if self.file.id.valid:
-            self.file.close()
+            try:
+                self.file.close()
+            except OSError:  # a failed write was already reported (run_to_file); the close fails for the same reason
+                pass
 
 
 class NotAResultFile(ValueError):

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from clearsim.errors import ClearsimError
-from clearsim.io.hdf5 import NotAResultFile, read_result
+from clearsim.io.hdf5 import NotAResultFile, ResultWriteError, read_result
 from clearsim.model.loader import load_mechanism_text
 from clearsim.runner import prepare, run_to_file
 from clearsim.sweep.figures import CaseRecord, read_record
@@ -111,6 +111,8 @@ def _attempt(task: CaseTask) -> CaseOutcome:
     report = run_to_file(system, loaded, output)
     if isinstance(report.error, KeyboardInterrupt):
         raise KeyboardInterrupt
+    if isinstance(report.error, ResultWriteError):
+        raise report.error  # a failed case, with the reason; its file may not be readable
     return _outcome(task.name, output, output_sensors, ran=True)
 
 

@@ -153,3 +153,41 @@ def test_every_bad_file_exits_2_from_the_cli_without_traceback_or_output(tmp_pat
     assert "Traceback" not in result.output and "sc.yaml:" in result.output
     assert fragments[-1].split("\n")[0] in result.output
     assert not out.exists()
+
+
+def test_an_output_folder_that_cannot_be_made_exits_2_with_the_path(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    result = invoke("run", SLIDER_CRANK, "-o", blocker / "run.h5", "--set", "solver.t_end=1ms")
+    assert result.exit_code == 2, result.output
+    assert f"cannot write the result file {blocker / 'run.h5'}" in result.output and "Traceback" not in result.output
+
+
+def test_too_little_free_space_exits_2_before_writing(tmp_path, monkeypatch):
+    import shutil
+    from collections import namedtuple
+
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(shutil, "disk_usage", lambda path: usage(10**9, 10**9 - 10**5, 10**5))
+    out = tmp_path / "sc.h5"
+    result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=2ms")
+    assert result.exit_code == 2, result.output
+    assert "MB free" in result.output and "solver.output_rate" in result.output
+    assert not out.exists()
+
+
+def test_a_disk_that_fills_up_mid_run_exits_2_and_the_file_says_failed(tmp_path, monkeypatch):
+    import errno
+
+    from clearsim.io.hdf5 import ResultWriter
+
+    def full(self, times, datasets):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(ResultWriter, "append", full)
+    out = tmp_path / "sc.h5"
+    result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=2ms")
+    assert result.exit_code == 2, result.output
+    assert "the disk is full" in result.output and "Traceback" not in result.output
+    with h5py.File(out) as handle:
+        assert not handle.attrs["complete"] and "disk is full" in handle.attrs["status"]

@@ -142,3 +142,21 @@ def test_monte_carlo_adds_percentiles_of_each_figure(tmp_path):
     assert table["peak_acceleration_m_s2"]["cases"] == "3"
     assert float(table["peak_acceleration_m_s2"]["p50"]) == pytest.approx(peak[1], rel=1e-12)
     assert "max_contact_force_N[slider_pin]" in table and "max_contact_force_N[slider_pin]" in result.output
+
+
+def test_a_case_whose_file_cannot_be_written_fails_with_the_reason_and_the_others_finish(tmp_path, monkeypatch):
+    from collections import namedtuple
+
+    from clearsim.sweep.execute import tasks_of
+    from clearsim.sweep.worker import COMPLETE, FAILED, run_case
+
+    plan = plan_sweep(SweepRequest(SLIDER_CRANK, ["solver.t_end=1ms"], "0.1,0.2", out=tmp_path / "sweep"), SLIDER_CRANK)
+    plan.folder.mkdir(parents=True)
+    first, second = tasks_of(plan)[:2]
+    real_usage = shutil.disk_usage
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(shutil, "disk_usage", lambda path: usage(10**9, 10**9 - 10**5, 10**5))
+    full = run_case(first)
+    monkeypatch.setattr(shutil, "disk_usage", real_usage)
+    assert full.state == FAILED and "MB free" in full.error and not Path(first.output).exists()
+    assert run_case(second).state == COMPLETE

@@ -49,8 +49,15 @@ def _terminate(signum, frame):
     raise KeyboardInterrupt
 
 
+def file_problem(exc: OSError) -> str:
+    """An OSError of the file system as one line: the file, the reason, what to do."""
+    where = f"{exc.filename}: " if exc.filename else ""
+    return (f"{where}{exc.strerror or exc}. hint: check that the path exists and can be written (or read), "
+            "or choose another one; --debug shows where it happened")
+
+
 def user_errors(command):
-    """Run a command; ClearsimError → message + exit 2, Ctrl-C/SIGTERM → exit 130."""
+    """Run a command; ClearsimError or a file-system OSError → message + exit 2, Ctrl-C/SIGTERM → exit 130."""
 
     @functools.wraps(command)
     def wrapper(*args, **kwargs):
@@ -63,6 +70,11 @@ def user_errors(command):
             if _state["debug"]:
                 raise
             errors.print(f"[bold red]error:[/] {escape(str(exc))}", markup=True, highlight=False, soft_wrap=True)
+            raise typer.Exit(INPUT_ERROR) from None
+        except OSError as exc:  # an output folder that cannot be made, a file that cannot be written or read
+            if _state["debug"]:
+                raise
+            errors.print(f"[bold red]error:[/] {escape(file_problem(exc))}", markup=True, highlight=False, soft_wrap=True)
             raise typer.Exit(INPUT_ERROR) from None
         except KeyboardInterrupt:
             errors.print("interrupted")

@@ -191,3 +191,18 @@ def test_a_disk_that_fills_up_mid_run_exits_2_and_the_file_says_failed(tmp_path,
     assert "the disk is full" in result.output and "Traceback" not in result.output
     with h5py.File(out) as handle:
         assert not handle.attrs["complete"] and "disk is full" in handle.attrs["status"]
+
+
+@pytest.mark.parametrize("command", ["plot", "sweep"])
+def test_an_output_folder_under_a_file_exits_2_with_the_path(tmp_path, command):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    if command == "plot":
+        result_file = tmp_path / "sc.h5"
+        assert invoke("run", SLIDER_CRANK, "-o", result_file, "--set", "solver.t_end=1ms").exit_code == 0
+        args = ("plot", result_file, "-o", blocker / "figures")
+    else:
+        args = ("sweep", SLIDER_CRANK, "--clearance", "0.1", "--set", "solver.t_end=1ms", "-o", blocker / "sweep")
+    result = invoke(*args)
+    assert result.exit_code == 2, result.output
+    assert str(blocker) in result.output and "Traceback" not in result.output

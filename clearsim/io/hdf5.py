@@ -91,6 +91,30 @@ def check_free_space(path: Path, needed_bytes: float) -> None:
                                "free some space, write elsewhere with -o, or lower solver.output_rate or solver.t_end")
 
 
+_WITH_GROUPS = h5py.h5p.create(h5py.h5p.LINK_CREATE)  # a dataset's path creates the groups it names
+_WITH_GROUPS.set_create_intermediate_group(True)
+_UNIT_TYPE = h5py.h5t.py_create(h5py.string_dtype("utf-8"), logical=True)  # as h5py stores a str attribute
+
+
+def new_dataset(parent: h5py.h5g.GroupID, name: str, values: np.ndarray, unit: str, chunk_rows: int | None = None):
+    """What h5py's create_dataset(name, data=values[, chunks, maxshape=(None, …)]) and attrs["unit"] = unit write, by
+    its low-level API: 3 ms instead of 7.5 ms for the 41 datasets of a slider-crank run. With chunk_rows, chunked and
+    growing along the first axis."""
+    dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+    dcpl.set_obj_track_times(False)  # h5py's default: the same values give the same file
+    if chunk_rows is not None:
+        dcpl.set_chunk((chunk_rows, *values.shape[1:]))
+        space = h5py.h5s.create_simple(values.shape, (h5py.h5s.UNLIMITED, *values.shape[1:]))
+    else:
+        space = h5py.h5s.create_simple(values.shape)
+    dataset = h5py.h5d.create(parent, name.encode(), h5py.h5t.py_create(values.dtype, logical=True), space, dcpl=dcpl,
+                              lcpl=_WITH_GROUPS)
+    if values.size:
+        dataset.write(h5py.h5s.ALL, h5py.h5s.ALL, values)
+    attribute = h5py.h5a.create(dataset, b"unit", _UNIT_TYPE, h5py.h5s.create(h5py.h5s.SCALAR))
+    attribute.write(np.array(unit, dtype=h5py.string_dtype("utf-8")))
+
+
 class ResultWriter:
     """Append-only writer of one run's result file."""
 
@@ -113,12 +137,10 @@ class ResultWriter:
         self.created: set[str] = set()
 
     def _append(self, name: str, values: np.ndarray, unit: str) -> None:
-        values = np.asarray(values)
+        values = np.ascontiguousarray(values)
         if name not in self.created:  # a set, not `name in self.file`: the lookup by path costs as much as the write
             chunk_rows = max(1, min(4096, 2**20 // max(1, values[0].nbytes if values.ndim > 1 else 8)))
-            dataset = self.file.create_dataset(name, data=values, maxshape=(None, *values.shape[1:]),
-                                               chunks=(chunk_rows, *values.shape[1:]))
-            dataset.attrs["unit"] = unit
+            new_dataset(self.file.id, name, values, unit, chunk_rows)
             self.created.add(name)
             return
         dataset = self.file[name]  # not kept open: an open dataset holds its chunk cache (up to 1 MB) until closed
@@ -146,8 +168,7 @@ class ResultWriter:
         for key, (values, unit) in columns.items():
             if key in group:
                 del group[key]
-            group.create_dataset(key, data=np.asarray(values))
-            group[key].attrs["unit"] = unit
+            new_dataset(group.id, key, np.ascontiguousarray(values), unit)
         for key, value in (attributes or {}).items():
             group.attrs[key] = value
 

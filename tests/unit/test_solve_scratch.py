@@ -1,0 +1,50 @@
+"""The constrained solve and its scratch (assembly/dynamics.py): exact against a dense solve of the augmented system,
+and its cached factor never stale — a factor computed for one q or one set of stick rows is not used for another."""
+
+import numpy as np
+
+from clearsim.assembly.arrays import for_kernels
+from clearsim.assembly.constraints import constraint_count, evaluate_acceleration_rhs, evaluate_jacobian
+from clearsim.assembly.dynamics import accelerations
+from clearsim.assembly.forces import CONTACT, STICK
+from clearsim.model.loader import load_mechanism
+from clearsim.runner import BUNDLED_CONFIG, prepare
+from tests.unit.test_constraints import mixed_system
+
+
+def test_accelerations_match_a_dense_solve_of_the_augmented_system():
+    system = mixed_system()
+    rng = np.random.default_rng(7)
+    t, q, qd, force = 0.013, rng.normal(size=9), rng.normal(size=9), rng.normal(size=9)
+    qdd, lam = accelerations(system, t, q, qd, force, np.zeros(0, np.int64))
+    m = constraint_count(system)
+    jac, gamma = np.zeros((m, 9)), np.zeros(m)
+    evaluate_jacobian(system, q, jac)
+    evaluate_acceleration_rhs(system, t, q, qd, gamma)
+    mass = np.diag(np.repeat([1.0, 2.0, 3.0], 3) * np.tile([1.0, 1.0, 0.0], 3) + np.repeat([0.1, 0.2, 0.3], 3)
+                   * np.tile([0.0, 0.0, 1.0], 3))
+    augmented = np.block([[mass, jac.T], [jac, np.zeros((m, m))]])
+    expected = np.linalg.solve(augmented, np.concatenate([force, gamma]))
+    assert np.allclose(qdd, expected[:9], rtol=1e-10, atol=1e-12)
+    assert np.allclose(lam, expected[9:], rtol=1e-10, atol=1e-12)
+
+
+def _uhv():
+    system = prepare(load_mechanism(BUNDLED_CONFIG))
+    return system, np.zeros(system.coordinate_count)
+
+
+def test_a_cached_factor_is_used_only_for_its_own_q_and_stick_rows():
+    system, force = _uhv()
+    shared = for_kernels(system.arrays)  # one scratch through every call below, as in a run
+    q_a, qd = system.q0, system.qd0
+    q_b = q_a + 1e-6 * np.random.default_rng(3).normal(size=q_a.size)
+    calls = [(q_a, (CONTACT, CONTACT)), (q_b, (CONTACT, CONTACT)), (q_b, (STICK, CONTACT)), (q_b, (STICK, STICK)),
+             (q_a, (STICK, STICK)), (q_a, (CONTACT, CONTACT)), (q_a, (CONTACT, CONTACT))]
+    for q, modes in calls:
+        modes = np.array(modes, np.int64)
+        reused = accelerations(shared, 0.001, q, qd, force, modes)
+        fresh = accelerations(for_kernels(system.arrays), 0.001, q, qd, force, modes)  # an empty scratch
+        for got, want in zip(reused, fresh):
+            assert np.array_equal(got, want)
+        assert len(reused[1]) == constraint_count(shared) + int(np.sum(modes == STICK))

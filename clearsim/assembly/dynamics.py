@@ -138,7 +138,7 @@ def stick_count(modes):
 
 @njit(cache=True)
 def stick_row_index(system, modes, k):
-    """Row of sticking joint k in jacobian_with_sticks: after Φ's rows, in joint order."""
+    """Row of sticking joint k among the rows of factored_jacobian: after Φ's rows, in joint order."""
     row = constraint_count(system)
     for other in range(k):
         if modes[other] == STICK:
@@ -163,16 +163,18 @@ def _factor_matches(system, q, modes, with_sticks):
 
 
 @njit(cache=True)
-def factored_jacobian(system, q, qd, modes, with_sticks, curvature):
-    """(blocks, bodies) of Φ_q at q, with one row G per sticking joint appended if with_sticks, as views of the
-    solve scratch, and S = Φ_q M⁻¹ Φ_qᵀ factorised there; Ġq̇ of the stick rows into curvature.
+def factored_jacobian(system, q, qd, modes, rows, curvature):
+    """(blocks, bodies) of Φ_q at q, with one row G per sticking joint appended if rows asks for them (rows: Φ's
+    alone or with the stick rows; a count computed at run time, not a literal flag, which would compile this kernel
+    once for each value), as views of the solve scratch, and S = Φ_q M⁻¹ Φ_qᵀ factorised there; Ġq̇ of the stick
+    rows into curvature.
 
     The rows depend on q alone (and on which joints stick), so a state's projection and its accelerations share
     one factor: it is computed again only when q or the stick rows change (the key kept with it in the scratch;
     every kernel that writes the scratch's rows comes through here).
     """
     m = constraint_count(system)
-    rows = m + (stick_count(modes) if with_sticks else 0)
+    with_sticks = rows > m
     blocks = system.solve_blocks[:rows]
     bodies = system.solve_bodies[:rows]
     fresh = not _factor_matches(system, q, modes, with_sticks)
@@ -207,7 +209,7 @@ def accelerations(system, t, q, qd, generalized, modes):
     if m + sticking == 0:
         return system.inverse_mass * generalized, np.zeros(0)
     gamma = system.solve_residual[:m + sticking]
-    blocks, bodies = factored_jacobian(system, q, qd, modes, True, gamma[m:])
+    blocks, bodies = factored_jacobian(system, q, qd, modes, m + sticking, gamma[m:])
     for i in range(sticking):
         gamma[m + i] = -gamma[m + i]
     evaluate_acceleration_rhs(system, t, q, qd, gamma)
@@ -276,7 +278,7 @@ def project_positions(system, t, q, modes, tolerance, max_iterations):
         evaluate_constraints(system, t, q, phi)
         if largest_magnitude(phi) <= tolerance:
             break
-        blocks, bodies = factored_jacobian(system, q, q, modes, False, phi)
+        blocks, bodies = factored_jacobian(system, q, q, modes, m, phi)
         subtract_minimum_norm_correction(system, blocks, bodies, phi, q)
     evaluate_constraints(system, t, q, phi)
     return largest_magnitude(phi)
@@ -289,7 +291,7 @@ def project_velocities(system, t, q, qd, modes):
     if m == 0:
         return
     residual = system.solve_residual[:m]
-    blocks, bodies = factored_jacobian(system, q, qd, modes, True, residual[constraint_count(system):])
+    blocks, bodies = factored_jacobian(system, q, qd, modes, m, residual[constraint_count(system):])
     nu = np.empty(m)
     evaluate_velocity_rhs(system, t, nu)
     jacobian_times(blocks, bodies, qd, residual)
@@ -324,7 +326,7 @@ def effective_mass(system, k, q, modes):
     if m == 0:
         response = system.inverse_mass * pair
     else:
-        blocks, bodies = factored_jacobian(system, q, q, modes, False, pair)
+        blocks, bodies = factored_jacobian(system, q, q, modes, m, pair)
         response = constrained_response(system, blocks, bodies, pair, np.zeros(m))[0]
     mobility = 0.0
     for i in range(n):  # not `pair @ response`: numba's dot is BLAS, whose set-up loads scipy.linalg (arrays.py)

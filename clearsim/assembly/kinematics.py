@@ -62,12 +62,6 @@ def frame_velocity(frame, qd, body, sx, sy):
 
 
 @njit(cache=True)
-def rotate(angle, sx, sy):
-    """A(θ) s."""
-    return frame_rotate((0.0, 0.0, np.cos(angle), np.sin(angle)), sx, sy)
-
-
-@njit(cache=True)
 def point_position(q, body, sx, sy):
     """r + A s: global position of a body-fixed point."""
     return frame_point(body_frame(q, body), sx, sy)
@@ -84,7 +78,7 @@ def add_point_force(generalized, q, body, sx, sy, fx, fy):
     """Add the generalised force of a global force (fx, fy) acting at a body-fixed point."""
     if body == GROUND:
         return
-    ax, ay = rotate(q[3 * body + 2], sx, sy)
+    ax, ay = frame_rotate(body_frame(q, body), sx, sy)
     generalized[3 * body] += fx
     generalized[3 * body + 1] += fy
     generalized[3 * body + 2] += ax * fy - ay * fx

@@ -129,6 +129,7 @@ class SolverError(ClearsimError):
         self.time = time
         self.element = element
         self.hint = hint
+        self.place: str | None = None  # "file:line:column  joints[k] 'name'" of the element, when known
         super().__init__(str(self))
 
     def __str__(self) -> str:
@@ -136,4 +137,5 @@ class SolverError(ClearsimError):
         if self.element:
             where += f", joint {self.element}"
         text = f"{where}: {self.message.rstrip('.')}."
+        text = f"{self.place}: {text}" if self.place else text
         return f"{text} {self.hint}" if self.hint else text

@@ -16,7 +16,7 @@ import numpy as np
 
 from clearsim.assembly.build import BuildError
 from clearsim.assembly.system import System, assemble
-from clearsim.errors import InputError, SolverError
+from clearsim.errors import InputError, SolverError, format_path
 from clearsim.io.hdf5 import (
     ResultWriter, check_free_space, group_attribute, interrupts_deferred, keep_existing, read_result, write_failure,
 )
@@ -100,6 +100,7 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                 if progress is not None:
                     progress(run.time)
         except SolverError as exc:
+            exc.place = element_place(loaded, exc.element)
             status, complete, error = f"failed: {exc}", False, exc
         except KeyboardInterrupt as exc:
             at = run.time if run is not None else 0.0
@@ -121,6 +122,17 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                 error, complete = write_failure(output, exc), False
     return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
                      run.warnings() if run is not None else [])
+
+
+def element_place(loaded: LoadedMechanism, element: str | None) -> str | None:
+    """Where the joint or driver a solver failure names is in the mechanism file: "file:line:column  joints[k] 'J'"."""
+    name = (element or "").split(" (")[0]
+    for path, item in loaded.source.names.items():
+        if len(path) == 2 and path[0] in ("joints", "drivers") and item == name:
+            position = loaded.source.locate(path)[0]
+            at = f"{loaded.path}:{position[0]}:{position[1]}" if position else str(loaded.path)
+            return f"{at}  {format_path(path, loaded.source.names)}"
+    return None
 
 
 def result_file_bytes(system: System) -> float:

@@ -117,6 +117,9 @@ def test_solver_failure_exits_2_with_time_and_joint_and_keeps_partial_results(tm
     result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=3ms", "--set", "solver.min_step=2e-5s")
     assert result.exit_code == 2
     assert "slider_pin" in result.output and "ms" in result.output and "Traceback" not in result.output
+    line = next(number for number, text in enumerate(Path(SLIDER_CRANK).read_text().splitlines(), 1)
+                if "name: slider_pin" in text)
+    assert f"{SLIDER_CRANK}:{line}:" in result.output and "joints[2] 'slider_pin'" in result.output  # the place
     with h5py.File(out) as f:
         assert not f.attrs["complete"] and f["time"].shape[0] > 1
 

@@ -115,7 +115,9 @@ def test_a_failing_case_is_recorded_and_the_others_finish(tmp_path):
                     "--set", "solver.min_step=1e-12s,5e-5s", "--workers", 2, "-o", out)
     assert result.exit_code == 2, result.output
     failing = "clearance-0.5_mm__solver.min_step-5e-5s"
-    assert "1 of 4 cases failed" in result.output and f"{failing}: at t = " in result.output
+    assert "1 of 4 cases failed" in result.output
+    listed = next(line for line in result.output.splitlines() if line.strip().startswith(f"{failing}: "))
+    assert "slider_crank_flores.yaml:" in listed and "joints[2] 'slider_pin': at t = " in listed  # where and when
     rows = read_summary(out)
     assert [rows[c]["status"] for c in rows] == ["complete", "complete", "complete", "failed"]
     assert "step size fell below solver.min_step" in rows[failing]["error"]

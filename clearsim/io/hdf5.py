@@ -120,19 +120,21 @@ class ResultWriter:
 
     def __init__(self, path: Path, config_yaml: str, attributes: dict | None = None):
         self.path = Path(path)
-        try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            self.file = h5py.File(self.path, "w")
-        except OSError as exc:
-            raise write_failure(self.path, exc) from None
-        root = self.file.attrs
-        root["clearsim_version"] = __version__
-        root["created"] = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
-        root["config_yaml"] = config_yaml
-        root["complete"] = False
-        root["status"] = "running"
-        for key, value in (attributes or {}).items():
-            root[key] = value
+        with interrupts_deferred():  # a Ctrl-C here would leave a file without `complete` and `status`
+            try:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+                self.file = h5py.File(self.path, "w")
+            except OSError as exc:
+                raise write_failure(self.path, exc) from None
+            root = self.file.attrs
+            root["clearsim_version"] = __version__
+            root["created"] = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
+            root["config_yaml"] = config_yaml
+            root["complete"] = False
+            root["status"] = "running"
+            for key, value in (attributes or {}).items():
+                root[key] = value
+            self.file.flush()
         self.rows = 0
         self.created: set[str] = set()
 

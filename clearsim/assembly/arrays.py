@@ -107,13 +107,18 @@ def _pack(fields):
     return KernelArrays(*fields)
 
 
+def mass_diagonal(arrays: SystemArrays) -> np.ndarray:
+    """The diagonal of M: m, m, J per body, in the order of q."""
+    return np.column_stack([arrays.mass, arrays.mass, arrays.inertia]).ravel()
+
+
 def _workspace(arrays: SystemArrays) -> tuple:
     """WORKSPACE_FIELDS for a system: rows = its constraint rows + one stick row per clearance joint."""
     bodies = arrays.mass.shape[0]
     rows = 2 * arrays.pin_bodies.shape[0] + arrays.offset_bodies.shape[0] + arrays.angle_bodies.shape[0]
     rows += arrays.clearance_bodies.shape[0]
     with np.errstate(divide="ignore"):  # as the kernels divide: a zero mass or inertia gives inf, not a warning
-        inverse_mass = np.column_stack([1.0 / arrays.mass, 1.0 / arrays.mass, 1.0 / arrays.inertia]).ravel()
+        inverse_mass = 1.0 / mass_diagonal(arrays)
     return (inverse_mass, np.zeros((rows, 2, 3)), np.zeros((rows, 2), np.int64), np.zeros((rows, rows)),
             np.zeros((rows, rows)), np.zeros(rows, np.int64), np.zeros(bodies + 1, np.int64),
             np.zeros((2 * rows, 2), np.int64), np.zeros(bodies, np.int64), np.zeros(3 * bodies), np.zeros(rows),

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from clearsim.assembly import build
-from clearsim.assembly.arrays import KernelArrays, SystemArrays, for_kernels
+from clearsim.assembly.arrays import KernelArrays, SystemArrays, for_kernels, mass_diagonal
 from clearsim.assembly.build import BuildError, ConstraintRows, Laws, Poses
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints, evaluate_jacobian, evaluate_velocity_rhs
 from clearsim.errors import Problem
@@ -230,7 +230,7 @@ def assemble(mechanism: schema.Mechanism, base_dir: Path | str = ".") -> System:
     assembly_kernel_arrays = for_kernels(assembly_arrays)
     q0 = _newton_assembly(assembly_kernel_arrays, _initial_coordinates(mechanism), assembly_owners)
     rank = _check_rank(for_kernels(arrays), q0, owners)
-    mass_diag = np.column_stack([arrays.mass, arrays.mass, arrays.inertia]).ravel()
+    mass_diag = mass_diagonal(arrays)
     qd0 = _consistent_velocities(assembly_kernel_arrays, q0, _initial_velocities(mechanism), mass_diag,
                                  clearances, 2 * len(rows.pins))
     n_offsets = len(rows.offsets)

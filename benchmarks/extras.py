@@ -41,8 +41,9 @@ SNIPPET = textwrap.dedent("""
 """)
 
 
-def _subprocess(config: Path, overrides: list[str], output: Path, cache: str | None) -> tuple[float, float, float]:
-    environment = dict(os.environ)
+def _subprocess(config: Path, overrides: list[str], output: Path, cache: str | None,
+                variables: dict | None = None) -> tuple[float, float, float]:
+    environment = dict(os.environ, **(variables or {}))
     if cache is not None:
         environment["NUMBA_CACHE_DIR"] = cache
     done = subprocess.run([sys.executable, "-c", SNIPPET, str(config), str(output), *overrides], env=environment,
@@ -53,13 +54,20 @@ def _subprocess(config: Path, overrides: list[str], output: Path, cache: str | N
 
 def compile_time(quick: bool, folder: Path, measurements, repeats: int = 1) -> dict:
     """A 1-ms slider-crank run in a fresh process with an empty cache, then again with that cache:
-    the difference is the compile time, paid once (later runs and sweep workers load the cache)."""
+    the difference is the compile time, paid once (later runs and sweep workers load the cache). Measured as a
+    first run does it (with the compile-ahead helper on a second core, clearsim/solver/precompile.py) and in
+    one process (CLEARSIM_COMPILE_AHEAD=0, e.g. a one-core machine)."""
     from benchmarks.suite import CRANK
+    from clearsim.solver.precompile import DISABLE_VARIABLE
 
-    cache = folder / "numba-cache"
-    cold, _, _ = _subprocess(CRANK, ["solver.t_end=1ms"], folder / "cold.h5", str(cache))
-    warm, _, _ = _subprocess(CRANK, ["solver.t_end=1ms"], folder / "warm.h5", str(cache))
-    return {"cold_s": cold, "warm_s": warm, "compile_s": cold - warm}
+    result = {}
+    for label, helper in (("", "1"), ("single_process_", "0")):
+        cache = folder / f"numba-cache-{label or 'helper'}"
+        environment = {DISABLE_VARIABLE: helper}
+        cold, _, _ = _subprocess(CRANK, ["solver.t_end=1ms"], folder / "cold.h5", str(cache), environment)
+        warm, _, _ = _subprocess(CRANK, ["solver.t_end=1ms"], folder / "warm.h5", str(cache), environment)
+        result.update({f"{label}cold_s": cold, f"{label}warm_s": warm, f"{label}compile_s": cold - warm})
+    return result
 
 
 def memory(quick: bool, folder: Path, measurements, repeats: int = 1) -> dict:
@@ -81,7 +89,10 @@ def describe(name: str, result) -> str:
                          f"output sampling {r['sampling_share']:.0%}, HDF5 writing {r['hdf5_share']:.0%}, "
                          f"other (load, assemble) {r['other_share']:.0%}" for r in result)
     if name == "compile":
-        return f"compile time (empty numba cache): {result['compile_s']:.1f} s (cold process {result['cold_s']:.1f} s, warm {result['warm_s']:.1f} s)"
+        single = (f"; in one process {result['single_process_compile_s']:.1f} s"
+                  if "single_process_compile_s" in result else "")
+        return (f"compile time (empty numba cache): {result['compile_s']:.1f} s (cold process {result['cold_s']:.1f} s, "
+                f"warm {result['warm_s']:.1f} s; with the compile-ahead helper){single}")
     if name == "memory":
         return f"peak memory (VmHWM), {result['t_end']} simulated at 10 kHz output: {result['peak_rss_mb']:.0f} MB"
     if name == "scaling":

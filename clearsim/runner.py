@@ -23,6 +23,7 @@ from clearsim.io.hdf5 import (
 from clearsim.model.loader import LoadedMechanism, load_mechanism
 from clearsim.solver.outputs import classify_episodes, chunk_outputs, sample_modes
 from clearsim.solver.simulate import Chunk, Run, Statistics
+from clearsim.solver import precompile
 
 BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
 DEFAULT_OUTPUT = Path("results") / "run.h5"
@@ -30,6 +31,7 @@ DEFAULT_OUTPUT = Path("results") / "run.h5"
 
 def prepare(loaded: LoadedMechanism) -> System:
     """Assemble a loaded mechanism; assembly problems are reported at their place in the file."""
+    precompile.start_if_cold()  # on an empty kernel cache, a second process compiles part of the loop meanwhile
     try:
         return assemble(loaded.mechanism, loaded.base_dir)
     except BuildError as exc:

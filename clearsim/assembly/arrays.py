@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import sys
 from collections import namedtuple
+from contextlib import contextmanager
 
 import numpy as np
 from numba import njit, types
@@ -138,7 +139,16 @@ _numba_target_ready = False
 
 
 def _first_pack(fields) -> KernelArrays:
-    """_pack, the process's first kernel call, with scipy's BLAS hidden from numba.
+    """_pack, the process's first kernel call, with scipy's BLAS hidden from numba (`blas_hidden`)."""
+    global _numba_target_ready
+    _numba_target_ready = True
+    with blas_hidden():
+        return _pack(fields)
+
+
+@contextmanager
+def blas_hidden():
+    """Around a process's first kernel call: numba's CPU target loads without scipy's BLAS.
 
     The first kernel a process calls loads numba's CPU target, which checks for BLAS by importing
     scipy.linalg.cython_blas: scipy.linalg and what it pulls in (numpy.testing, numpy.f2py, ...) cost 18 MB of
@@ -146,14 +156,13 @@ def _first_pack(fields) -> KernelArrays:
     inside a kernel), so numba is told there is none; scipy.linalg itself stays importable for everything else.
     If scipy.linalg is already loaded (diagnose), there is nothing to save and nothing is hidden.
     """
-    global _numba_target_ready
-    _numba_target_ready = True
     name = "scipy.linalg.cython_blas"
     if "scipy.linalg" in sys.modules or name in sys.modules:
-        return _pack(fields)
+        yield
+        return
     sys.modules[name] = None  # `import scipy.linalg.cython_blas` raises ImportError: numba records "no BLAS"
     try:
-        return _pack(fields)
+        yield
     finally:
         del sys.modules[name]
 

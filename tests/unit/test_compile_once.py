@@ -1,9 +1,13 @@
-"""Every kernel a run needs is compiled once (docs/performance.md, *Compile time*).
+"""Every kernel a run needs is compiled once, and what the compile-ahead helper writes is what the run loads
+(docs/performance.md, *Compile time*).
 
 numba types a constant argument (`True`, `-1`, `NORMAL`) as a literal and compiles the callee, with its whole
 subtree, once for each literal it sees; session 4 removed 23 such double compilations, and session 6 found one it had
-brought back itself (a `with_sticks` flag, ~1 s of compile time). This compiles a short run on an empty kernel cache
-in a fresh process (~20 s) and lists the kernels compiled more than once.
+brought back itself (a `with_sticks` flag, ~1 s of compile time). On an empty kernel cache, the helper
+(`python -m clearsim.solver.precompile`) compiles the kernels of `AHEAD` first, as it does beside a first run; a run
+in a fresh process then compiles the rest (~20 s together) and is checked for kernels compiled twice, for kernels
+of AHEAD it compiled itself (the helper's signatures no longer match the run's), and for results that differ from a
+run on the suite's own kernel cache.
 """
 
 import os
@@ -11,28 +15,60 @@ import subprocess
 import sys
 from pathlib import Path
 
-from clearsim.runner import BUNDLED_CONFIG
+import h5py
+import numpy as np
 
+from clearsim.runner import BUNDLED_CONFIG, simulate_config
+from clearsim.solver.precompile import AHEAD, DISABLE_VARIABLE
+
+ROOT = Path(__file__).resolve().parents[2]
 SCRIPT = """
 import collections, sys
 from numba.core import event
 with event.install_recorder("numba:compile") as recorder:
-    from clearsim.runner import simulate_config
-    simulate_config(sys.argv[1], ["solver.t_end=1ms"], sys.argv[2])
+    if sys.argv[1] == "helper":
+        from clearsim.solver.precompile import compile_ahead
+        print(" ".join(compile_ahead()))
+    else:
+        from clearsim.runner import simulate_config
+        simulate_config(sys.argv[1], ["solver.t_end=1ms"], sys.argv[2])
+        print()
 counts = collections.Counter()
 for _, compile_event in recorder.buffer:
     function = getattr(compile_event.data.get("dispatcher"), "py_func", None)
     if compile_event.is_start and function is not None and str(function.__module__).startswith("clearsim"):
         counts[f"{function.__module__}.{function.__qualname__}"] += 1
-print(len(counts), sorted(name for name, count in counts.items() if count > 1))
+print(";".join(f"{name}={count}" for name, count in sorted(counts.items())))
 """
 
+def _datasets(path):
+    values = {}
+    with h5py.File(path) as result:
+        result.visititems(lambda name, item: values.__setitem__(name, item[()])
+                          if isinstance(item, h5py.Dataset) and item.dtype.kind in "fiu" else None)
+    return values
 
-def test_every_kernel_of_a_run_is_compiled_once(tmp_path):
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "empty-cache"))
-    done = subprocess.run([sys.executable, "-c", SCRIPT, str(BUNDLED_CONFIG), str(tmp_path / "run.h5")], env=env,
-                          capture_output=True, text=True, timeout=600, cwd=Path(__file__).resolve().parents[2])
+
+def _compiled(env, *arguments) -> tuple[list[str], dict[str, int]]:
+    """(the helper's list, {kernel: compilations}) of a fresh process."""
+    done = subprocess.run([sys.executable, "-c", SCRIPT, *map(str, arguments)], env=env, capture_output=True,
+                          text=True, timeout=600, cwd=ROOT)
     assert done.returncode == 0, done.stderr
-    kernels, twice = done.stdout.split(" ", 1)
-    assert int(kernels) > 40  # the run did compile its kernels (an empty cache)
-    assert twice.strip() == "[]"
+    listed, counts = done.stdout.split("\n")[:2]
+    return listed.split(), {name: int(count) for name, count in (item.split("=") for item in counts.split(";"))}
+
+
+def test_helper_then_run_compile_every_kernel_once_with_the_same_results(tmp_path):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "empty-cache"), **{DISABLE_VARIABLE: "0"})
+    ahead = [name for _, name, _ in AHEAD]
+    listed, by_helper = _compiled(env, "helper")
+    assert listed == ahead
+    _, by_run = _compiled(env, BUNDLED_CONFIG, tmp_path / "run.h5")
+    assert len(by_helper) + len(by_run) > 50 and "clearsim.solver.integrator.advance" in by_run  # an empty cache
+    assert [name for name, count in {**by_helper, **by_run}.items() if count > 1] == []
+    assert sorted(by_helper.keys() & by_run.keys()) == []  # the run loaded all the helper wrote
+
+    simulate_config(BUNDLED_CONFIG, ["solver.t_end=1ms"], tmp_path / "suite-cache.h5")
+    ours, theirs = _datasets(tmp_path / "run.h5"), _datasets(tmp_path / "suite-cache.h5")
+    assert ours.keys() == theirs.keys()
+    assert [name for name in ours if not np.array_equal(ours[name], theirs[name], equal_nan=True)] == []

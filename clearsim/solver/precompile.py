@@ -1,0 +1,147 @@
+"""Compile ahead: on an empty kernel cache, a second process compiles part of the loop's kernels meanwhile.
+
+numba compiles in one thread per process, and a run's first call of `advance` compiles it with every kernel it
+calls (~20 s, docs/performance.md *Compile time*). When the cache holds no `advance`, the first run (`prepare`)
+starts `python -m clearsim.solver.precompile`, which compiles the kernels of `AHEAD` in that order into the same
+cache while the run compiles the assembly's kernels and starts on `advance`. When the run's compilation reaches
+a kernel the helper has already written, numba loads it from the cache instead of compiling it (the same
+machine code: the cache is keyed by the sources, and a cached kernel keeps the bitcode its callers link in).
+Nothing waits for the helper: a kernel both processes reach first is compiled by both, which costs CPU only.
+
+Only one helper runs per cache (a lock file), only with two or more cores, and never when the variable
+CLEARSIM_COMPILE_AHEAD is 0. The helper's output is discarded; if it fails, the run compiles what it needs
+itself, as it does without one.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+from numba import typeof, types
+from numba.core import config
+
+LOCK_NAME = "compile-ahead.lock"
+DISABLE_VARIABLE = "CLEARSIM_COMPILE_AHEAD"
+
+F, I = types.float64, types.int64
+V, IV, M = types.float64[::1], types.int64[::1], types.float64[:, ::1]
+
+# (module, kernel, argument types after the system): what the helper compiles, in this order. The run reaches
+# the right-hand side first (after the assembly's kernels and `advance`'s own early passes), so the helper starts
+# with the two halves of it and goes on with what the run needs later. This order measured best of those tried
+# (docs/performance.md); compiling `switch_mode` too (9 s with its subtree) made the run slower.
+AHEAD = (
+    ("clearsim.assembly.dynamics", "accelerations", (F, V, V, V, IV)),
+    ("clearsim.assembly.dynamics", "generalized_forces", (F, V, V, IV, V)),
+    ("clearsim.solver.integrator", "event_value", (I, I, F, V, IV, V)),
+    ("clearsim.solver.samples", "derive_sample", (F, V, IV, V, V, V, M, V)),
+    ("clearsim.solver.integrator", "project_state", (F, V, IV)),
+    ("clearsim.solver.integrator", "_value_at", (I, I, F, V, M, F, F, IV, V, V)),
+    ("clearsim.solver.integrator", "normal_force_at", (I, V, M, F, F, IV, V, V)),
+)
+
+# dtype and dimensions of each field of KernelArrays, as build.pack and arrays._workspace make them
+# (tests/unit/test_precompile.py compares them with an assembled system's)
+FIELD_LAYOUT = {
+    "mass": ("f8", 1), "inertia": ("f8", 1), "gravity": ("f8", 1),
+    "pin_bodies": ("i8", 2), "pin_points": ("f8", 2),
+    "offset_bodies": ("i8", 2), "offset_params": ("f8", 2), "offset_law": ("i8", 1),
+    "angle_bodies": ("i8", 2), "angle_value": ("f8", 1), "angle_law": ("i8", 1),
+    "law_breaks": ("f8", 1), "law_coefficients": ("f8", 2), "law_first": ("i8", 1), "law_count": ("i8", 1),
+    "clearance_bodies": ("i8", 2), "clearance_laws": ("i8", 2), "clearance_params": ("f8", 2),
+    "load_bodies": ("i8", 1), "load_params": ("f8", 2), "load_law": ("i8", 1),
+    "spring_bodies": ("i8", 2), "spring_params": ("f8", 2),
+    "inverse_mass": ("f8", 1), "solve_blocks": ("f8", 3), "solve_bodies": ("i8", 2), "solve_schur": ("f8", 2),
+    "solve_lower": ("f8", 2), "solve_envelope": ("i8", 1), "solve_body_start": ("i8", 1),
+    "solve_entries": ("i8", 2), "solve_body_fill": ("i8", 1), "solve_vector": ("f8", 1),
+    "solve_residual": ("f8", 1), "factor_key": ("i8", 1), "factor_q": ("f8", 1),
+}
+
+_helper: subprocess.Popen | None = None
+
+
+def system_type():
+    """The numba type of every system's KernelArrays (one type for all mechanisms)."""
+    from clearsim.assembly.arrays import KernelArraysType
+
+    return KernelArraysType([(name, typeof(np.zeros((0,) * ndim, dtype))) for name, (dtype, ndim)
+                             in FIELD_LAYOUT.items()])
+
+
+def kernels_ahead():
+    """(dispatcher, full signature) of each kernel of AHEAD, in order."""
+    import importlib
+
+    system = system_type()
+    return [(getattr(importlib.import_module(module), name), (system, *arguments))
+            for module, name, arguments in AHEAD]
+
+
+def _cache_is_cold() -> bool:
+    """No compiled `advance` in the kernel cache (numba's index file for it is missing)."""
+    from clearsim.solver.integrator import advance
+
+    index = getattr(getattr(getattr(advance, "_cache", None), "_cache_file", None), "_index_path", None)
+    return index is not None and not Path(index).exists()
+
+
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:
+        return os.cpu_count() or 1
+
+
+def start_if_cold() -> None:
+    """Start the helper, once per process, when the cache is cold and a second core is there to run it."""
+    global _helper
+    if _helper is not None or os.environ.get(DISABLE_VARIABLE, "1") == "0" or _cores() < 2:
+        return
+    try:
+        import fcntl  # noqa: F401  (POSIX: the lock that keeps it to one helper per cache)
+    except ImportError:
+        return
+    if not _cache_is_cold():
+        return
+    _helper = subprocess.Popen([sys.executable, "-m", "clearsim.solver.precompile"], stdin=subprocess.DEVNULL,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    atexit.register(_stop_helper)
+
+
+def _stop_helper() -> None:
+    """At exit: what the helper has written stays in the cache; it is not left running behind the run."""
+    if _helper is not None and _helper.poll() is None:
+        _helper.terminate()
+        _helper.wait()
+
+
+def compile_ahead() -> list[str]:
+    """The helper's work: compile AHEAD into the cache, under the lock; returns the kernels compiled."""
+    import fcntl
+
+    from clearsim.assembly.arrays import blas_hidden
+
+    if not config.CACHE_DIR:
+        return []
+    folder = Path(config.CACHE_DIR)
+    folder.mkdir(parents=True, exist_ok=True)
+    with open(folder / LOCK_NAME, "w") as lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            return []  # another helper is compiling into this cache
+        done = []
+        with blas_hidden():
+            for kernel, signature in kernels_ahead():
+                kernel.compile(signature)
+                done.append(kernel.py_func.__name__)
+        return done
+
+
+if __name__ == "__main__":
+    print(" ".join(compile_ahead()))

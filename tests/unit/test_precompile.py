@@ -1,0 +1,75 @@
+"""The compile-ahead helper: its system type is every system's, it starts only on a cold cache with a second core,
+one at a time per cache, and never when switched off (clearsim/solver/precompile.py)."""
+
+import fcntl
+import inspect
+import os
+import subprocess
+import sys
+
+import pytest
+from numba import typeof
+from numba.core import config
+
+from clearsim.assembly.arrays import for_kernels
+from clearsim.model.loader import load_mechanism
+from clearsim.runner import BUNDLED_CONFIG, prepare, simulate_config
+from clearsim.solver import precompile
+
+CRANK = BUNDLED_CONFIG.parent / "slider_crank_flores.yaml"
+
+
+@pytest.mark.parametrize("config", [BUNDLED_CONFIG, CRANK], ids=["uhv", "crank"])
+def test_the_helpers_system_type_is_an_assembled_systems(config):
+    system = prepare(load_mechanism(config, []))
+    assert typeof(for_kernels(system.arrays)) == precompile.system_type()
+
+
+def _spawned(monkeypatch, cold=True, cores=2, variable=None):
+    started = []
+    monkeypatch.setattr(precompile, "_helper", None)
+    monkeypatch.setattr(precompile, "_cache_is_cold", lambda: cold)
+    monkeypatch.setattr(precompile, "_cores", lambda: cores)
+    monkeypatch.setattr(precompile.subprocess, "Popen", lambda *args, **kwargs: started.append(args) or _Finished())
+    monkeypatch.setattr(precompile.atexit, "register", lambda function: None)
+    if variable is None:
+        monkeypatch.delenv(precompile.DISABLE_VARIABLE, raising=False)
+    else:
+        monkeypatch.setenv(precompile.DISABLE_VARIABLE, variable)
+    precompile.start_if_cold()
+    precompile.start_if_cold()  # once per process
+    return len(started)
+
+
+class _Finished:
+    def poll(self):
+        return 0
+
+
+def test_the_helper_starts_once_on_a_cold_cache_only(monkeypatch):
+    assert _spawned(monkeypatch) == 1
+    assert _spawned(monkeypatch, cold=False) == 0
+    assert _spawned(monkeypatch, cores=1) == 0
+    assert _spawned(monkeypatch, variable="0") == 0
+    assert _spawned(monkeypatch, variable="1") == 1
+
+
+def test_the_cache_is_cold_until_a_run_has_compiled_advance(tmp_path):
+    probe = "from clearsim.solver import precompile; print(precompile._cache_is_cold())"
+    empty = subprocess.run([sys.executable, "-c", probe], env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path)),
+                           capture_output=True, text=True, timeout=120)
+    assert empty.stdout.strip() == "True", empty.stderr
+    simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")  # this process's cache now holds `advance`
+    assert not precompile._cache_is_cold()
+
+
+def test_a_second_helper_on_the_same_cache_compiles_nothing(tmp_path, monkeypatch):
+    monkeypatch.setattr(config, "CACHE_DIR", str(tmp_path))
+    with open(tmp_path / precompile.LOCK_NAME, "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)  # the first helper holds it
+        assert precompile.compile_ahead() == []
+
+
+def test_every_kernel_ahead_exists_with_its_number_of_arguments():
+    for kernel, signature in precompile.kernels_ahead():
+        assert len(inspect.signature(kernel.py_func).parameters) == len(signature), kernel.py_func.__name__

@@ -57,7 +57,8 @@ def _attributes(system: System, loaded: LoadedMechanism) -> dict:
 
 def _final_attributes(run: Run) -> dict:
     stats = run.statistics()
-    return {"wall_time_s": stats.wall_time, "steps": stats.steps, "rejected_steps": stats.rejected_steps,
+    return {"wall_time_s": stats.wall_time, "kernel_time_s": stats.kernel_time,
+            "kernels_compiled": stats.kernels_compiled, "steps": stats.steps, "rejected_steps": stats.rejected_steps,
             "rhs_evaluations": stats.rhs_evaluations, "contact_events": stats.contact_events,
             "max_step_violation": stats.max_violation, "simulated_time_s": run.time,
             "tolerance_over_penetration": stats.tolerance_over_penetration, "warnings": "\n".join(run.warnings())}

@@ -82,7 +82,7 @@ def kernels_ahead():
             for module, name, arguments in AHEAD]
 
 
-def _cache_is_cold() -> bool:
+def cache_is_cold() -> bool:
     """No compiled `advance` in the kernel cache (numba's index file for it is missing)."""
     from clearsim.solver.integrator import advance
 
@@ -106,7 +106,7 @@ def start_if_cold() -> None:
         import fcntl  # noqa: F401  (POSIX: the lock that keeps it to one helper per cache)
     except ImportError:
         return
-    if not _cache_is_cold():
+    if not cache_is_cold():
         return
     _helper = subprocess.Popen([sys.executable, "-m", "clearsim.solver.precompile"], stdin=subprocess.DEVNULL,
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)

@@ -21,6 +21,7 @@ from clearsim.assembly.forces import FREE
 from clearsim.assembly.system import System
 from clearsim.errors import SolverError
 from clearsim.solver import integrator as ig
+from clearsim.solver import precompile
 from clearsim.solver.samples import CONTACT_FIELDS, ENERGY_FIELDS, E_KINETIC, E_POTENTIAL, E_VIOLATION
 
 SAMPLE_BUFFER = 2048
@@ -59,7 +60,9 @@ class Statistics:
     rhs_evaluations: int = 0
     contact_events: int = 0
     max_violation: float = 0.0
-    wall_time: float = 0.0
+    wall_time: float = 0.0  # s in the compiled loop, without its first call (below)
+    kernel_time: float = 0.0  # s of the loop's first call in this run: loading it, or on an empty cache compiling it
+    kernels_compiled: bool = False  # the kernel cache held no compiled loop when the run started
     peak_normal_force: np.ndarray = field(default_factory=lambda: np.zeros(0))
     tolerance_over_penetration: float = 0.0  # largest over the contact onsets (docs/model.md §4)
 
@@ -120,6 +123,8 @@ class Run:
         # here (numpy's sums, as always: the step, and so every result, stays bitwise the same); calling the
         # compiled rhs from Python instead would load a second copy of the dynamics (docs/performance.md)
         self.wall_time = 0.0
+        self.kernel_time = 0.0
+        self.kernels_compiled = precompile.cache_is_cold()
         self.coordinate_count = n
 
     @property
@@ -130,7 +135,8 @@ class Run:
         return Statistics(
             steps=int(self.ints[ig.I_STEPS]), rejected_steps=int(self.ints[ig.I_REJECTED]),
             rhs_evaluations=int(self.ints[ig.I_RHS]), contact_events=int(self.ints[ig.I_EVENTS]),
-            max_violation=float(self.real[ig.R_VIOLATION]), wall_time=self.wall_time,
+            max_violation=float(self.real[ig.R_VIOLATION]), wall_time=self.wall_time, kernel_time=self.kernel_time,
+            kernels_compiled=self.kernels_compiled,
             peak_normal_force=self.peak_force.copy(), tolerance_over_penetration=float(self.real[ig.R_COARSE_RATIO]),
         )
 
@@ -160,7 +166,10 @@ class Run:
         started = clock.perf_counter()
         ig.advance(self.kernel_arrays, self.y, self.f, self.real, self.ints, self.modes, self.speeds,
                    self.episode_of, *self.log, self.peak_force, *self.buffers, t_stop)
-        self.wall_time += clock.perf_counter() - started
+        if self.ints[ig.I_STATUS] == ig.FIRST_STEP:  # the first call: loads (or compiles) the loop, one rhs
+            self.kernel_time += clock.perf_counter() - started
+        else:
+            self.wall_time += clock.perf_counter() - started
 
     def _take_samples(self) -> Chunk | None:
         count = int(self.ints[ig.I_SAMPLES])

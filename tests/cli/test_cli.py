@@ -34,7 +34,7 @@ def test_run_writes_the_file_and_prints_the_summary(tmp_path):
     result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=2ms")
     assert result.exit_code == 0, result.output
     for text in ("peak |slider_velocity|", "peak |slider_acceleration|", "joint slider_pin: max contact force", "joint slider_pin: free / impact / contact",
-                 "steps (rejected)", "contact events", "wall time"):
+                 "steps (rejected)", "contact events", "wall time", "compiled loop"):
         assert text in result.output
     with h5py.File(out) as f:
         assert bool(f.attrs["complete"]) and f["time"][-1] == pytest.approx(0.002)

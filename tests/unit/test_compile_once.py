@@ -72,3 +72,5 @@ def test_helper_then_run_compile_every_kernel_once_with_the_same_results(tmp_pat
     ours, theirs = _datasets(tmp_path / "run.h5"), _datasets(tmp_path / "suite-cache.h5")
     assert ours.keys() == theirs.keys()
     assert [name for name in ours if not np.array_equal(ours[name], theirs[name], equal_nan=True)] == []
+    with h5py.File(tmp_path / "run.h5") as cold, h5py.File(tmp_path / "suite-cache.h5") as warm:
+        assert bool(cold.attrs["kernels_compiled"]) and not bool(warm.attrs["kernels_compiled"])

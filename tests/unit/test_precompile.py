@@ -28,7 +28,7 @@ def test_the_helpers_system_type_is_an_assembled_systems(config):
 def _spawned(monkeypatch, cold=True, cores=2, variable=None):
     started = []
     monkeypatch.setattr(precompile, "_helper", None)
-    monkeypatch.setattr(precompile, "_cache_is_cold", lambda: cold)
+    monkeypatch.setattr(precompile, "cache_is_cold", lambda: cold)
     monkeypatch.setattr(precompile, "_cores", lambda: cores)
     monkeypatch.setattr(precompile.subprocess, "Popen", lambda *args, **kwargs: started.append(args) or _Finished())
     monkeypatch.setattr(precompile.atexit, "register", lambda function: None)
@@ -54,13 +54,13 @@ def test_the_helper_starts_once_on_a_cold_cache_only(monkeypatch):
     assert _spawned(monkeypatch, variable="1") == 1
 
 
-def test_the_cache_is_cold_until_a_run_has_compiled_advance(tmp_path):
-    probe = "from clearsim.solver import precompile; print(precompile._cache_is_cold())"
+def test_thecache_is_cold_until_a_run_has_compiled_advance(tmp_path):
+    probe = "from clearsim.solver import precompile; print(precompile.cache_is_cold())"
     empty = subprocess.run([sys.executable, "-c", probe], env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path)),
                            capture_output=True, text=True, timeout=120)
     assert empty.stdout.strip() == "True", empty.stderr
     simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")  # this process's cache now holds `advance`
-    assert not precompile._cache_is_cold()
+    assert not precompile.cache_is_cold()
 
 
 def test_a_second_helper_on_the_same_cache_compiles_nothing(tmp_path, monkeypatch):

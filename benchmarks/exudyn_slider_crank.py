@@ -136,9 +136,9 @@ def _settings(t_end: float, step: float, record_period: float):
     integration.discontinuous.ignoreMaxIterations = True
     integration.discontinuous.maxIterations = 1
     integration.discontinuous.useRecommendedStepSize = False
-    integration.explicitIntegration.computeEndOfStepAccelerations = True  # the slider acceleration is an output
-    settings.solutionSettings.writeSolutionToFile = False
-    settings.solutionSettings.sensorsWritePeriod = record_period
+    integration.explicit.computeEndOfStepAccelerations = True  # the slider acceleration is an output
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = record_period
     settings.linearSolver.solverType = exu.LinearSolverType.EXUdense
     return settings
 

@@ -108,8 +108,11 @@ def start_if_cold() -> None:
         return
     if not cache_is_cold():
         return
-    _helper = subprocess.Popen([sys.executable, "-m", "clearsim.solver.precompile"], stdin=subprocess.DEVNULL,
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        _helper = subprocess.Popen([sys.executable, "-m", "clearsim.solver.precompile"], stdin=subprocess.DEVNULL,
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    except (OSError, ValueError):  # no interpreter to start (embedded Python): the run compiles alone
+        return
     atexit.register(_stop_helper)
 
 

@@ -46,6 +46,16 @@ class _Finished:
         return 0
 
 
+def test_a_helper_that_cannot_start_leaves_the_run_to_compile_alone(monkeypatch):
+    monkeypatch.setattr(precompile, "_helper", None)
+    monkeypatch.setattr(precompile, "cache_is_cold", lambda: True)
+    monkeypatch.setattr(precompile, "_cores", lambda: 2)
+    monkeypatch.setattr(precompile.sys, "executable", "")
+    monkeypatch.delenv(precompile.DISABLE_VARIABLE, raising=False)
+    precompile.start_if_cold()
+    assert precompile._helper is None
+
+
 def test_the_helper_starts_once_on_a_cold_cache_only(monkeypatch):
     assert _spawned(monkeypatch) == 1
     assert _spawned(monkeypatch, cold=False) == 0

@@ -1,7 +1,7 @@
 """Compile ahead: on an empty kernel cache, a second process compiles part of the loop's kernels meanwhile.
 
 numba compiles in one thread per process, and a run's first call of `advance` compiles it with every kernel it
-calls (~20 s, docs/performance.md *Compile time*). When the cache holds no `advance`, the first run (`prepare`)
+calls (~19 s, docs/performance.md *Compile time*). When the cache holds no `advance`, the first run (`prepare`)
 starts `python -m clearsim.solver.precompile`, which compiles the kernels of `AHEAD` in that order into the same
 cache while the run compiles the assembly's kernels and starts on `advance`. When the run's compilation reaches
 a kernel the helper has already written, numba loads it from the cache instead of compiling it (the same
@@ -16,6 +16,7 @@ itself, as it does without one.
 from __future__ import annotations
 
 import atexit
+import importlib
 import os
 import subprocess
 import sys
@@ -24,6 +25,9 @@ from pathlib import Path
 import numpy as np
 from numba import typeof, types
 from numba.core import config
+
+from clearsim.assembly.arrays import KernelArraysType, blas_hidden
+from clearsim.solver.integrator import advance
 
 LOCK_NAME = "compile-ahead.lock"
 DISABLE_VARIABLE = "CLEARSIM_COMPILE_AHEAD"
@@ -67,16 +71,12 @@ _helper: subprocess.Popen | None = None
 
 def system_type():
     """The numba type of every system's KernelArrays (one type for all mechanisms)."""
-    from clearsim.assembly.arrays import KernelArraysType
-
     return KernelArraysType([(name, typeof(np.zeros((0,) * ndim, dtype))) for name, (dtype, ndim)
                              in FIELD_LAYOUT.items()])
 
 
 def kernels_ahead():
     """(dispatcher, full signature) of each kernel of AHEAD, in order."""
-    import importlib
-
     system = system_type()
     return [(getattr(importlib.import_module(module), name), (system, *arguments))
             for module, name, arguments in AHEAD]
@@ -84,8 +84,6 @@ def kernels_ahead():
 
 def cache_is_cold() -> bool:
     """No compiled `advance` in the kernel cache (numba's index file for it is missing)."""
-    from clearsim.solver.integrator import advance
-
     index = getattr(getattr(getattr(advance, "_cache", None), "_cache_file", None), "_index_path", None)
     return index is not None and not Path(index).exists()
 
@@ -126,8 +124,6 @@ def _stop_helper() -> None:
 def compile_ahead() -> list[str]:
     """The helper's work: compile AHEAD into the cache, under the lock; returns the kernels compiled."""
     import fcntl
-
-    from clearsim.assembly.arrays import blas_hidden
 
     if not config.CACHE_DIR:
         return []

@@ -2,6 +2,7 @@
 
 import hashlib
 import os
+import sys
 from pathlib import Path
 
 __version__ = "0.1.0"
@@ -25,3 +26,8 @@ def _kernel_cache_dir() -> str:
 
 
 os.environ.setdefault("NUMBA_CACHE_DIR", _kernel_cache_dir())
+if "numba.core.config" in sys.modules:
+    # numba, imported first (a notebook, a test module), read the variable before it was set, and chooses each
+    # kernel's cache folder when the kernel is defined: without this, ours would go next to the sources, keyed by
+    # each file alone
+    sys.modules["numba.core.config"].CACHE_DIR = os.environ["NUMBA_CACHE_DIR"]

@@ -64,7 +64,7 @@ def test_the_helper_starts_once_on_a_cold_cache_only(monkeypatch):
     assert _spawned(monkeypatch, variable="1") == 1
 
 
-def test_thecache_is_cold_until_a_run_has_compiled_advance(tmp_path):
+def test_the_cache_is_cold_until_a_run_has_compiled_advance(tmp_path):
     probe = "from clearsim.solver import precompile; print(precompile.cache_is_cold())"
     empty = subprocess.run([sys.executable, "-c", probe], env=dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path)),
                            capture_output=True, text=True, timeout=120)

@@ -18,6 +18,7 @@ from typing import Any, Sequence
 import yaml
 from pydantic import ValidationError
 from yaml.constructor import SafeConstructor
+from yaml.events import MappingEndEvent, MappingStartEvent, SequenceEndEvent, SequenceStartEvent
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from clearsim.errors import InputError, Problem
@@ -99,7 +100,8 @@ class SourceMap:
                     self.names.setdefault(path, value.value)
 
 
-def _position(node: Node) -> tuple[int, int]:
+def _position(node) -> tuple[int, int]:
+    """(line, column), 1-based, where a node or an event starts."""
     return node.start_mark.line + 1, node.start_mark.column + 1
 
 
@@ -131,6 +133,8 @@ _SYNTAX_HINTS = {
     "could not determine a constructor": "a mechanism file is plain YAML: remove the tag (!!...)",
     "expected a single document": "a mechanism file holds one YAML document: remove the extra '---'",
 }
+MAX_NESTING = 50  # levels of mappings and lists; a mechanism file needs 5 (bodies → item → points → name → [x, y])
+MAX_VALUES = 100_000  # values once aliases are expanded; a large mechanism file has a few thousand
 
 
 def _syntax_problem(exc: yaml.YAMLError) -> Problem:
@@ -140,6 +144,71 @@ def _syntax_problem(exc: yaml.YAMLError) -> Problem:
     hint = next((h for key, h in _SYNTAX_HINTS.items() if key in text), "check the YAML syntax at this line")
     position = (mark.line + 1, mark.column + 1) if mark is not None else None
     return Problem((), f"invalid YAML: {text}", hint, position=position)
+
+
+def _too_deep(position: tuple[int, int]) -> Problem:
+    return Problem((), f"invalid YAML: nested more than {MAX_NESTING} levels deep",
+                   "a mechanism file nests a few levels (bodies → item → points): look for brackets opened and "
+                   "never closed, or aliases (*name) inside the blocks they repeat", position=position)
+
+
+def nesting_problem(text: str) -> Problem | None:
+    """Nesting deeper than MAX_NESTING, found in libyaml's events before its recursive composer meets it.
+
+    (libyaml's composer overflows the C stack, a crash, some 20 000 levels down; Python code below recurses too.)
+    """
+    depth = 0
+    try:
+        for event in yaml.parse(text, Loader=FAST_LOADER):
+            if isinstance(event, (MappingStartEvent, SequenceStartEvent)):
+                depth += 1
+                if depth > MAX_NESTING:
+                    return _too_deep(_position(event))
+            elif isinstance(event, (MappingEndEvent, SequenceEndEvent)):
+                depth -= 1
+    except yaml.YAMLError:
+        return None  # a syntax error before any deep nesting: the parse that follows reports it
+    return None
+
+
+def alias_problem(root: Node | None) -> Problem | None:
+    """Aliases that make the document contain itself, or expand it beyond MAX_VALUES values or MAX_NESTING levels.
+
+    Walked without recursion: each of these would otherwise recurse without end or take hours.
+    """
+    on_path: set[int] = set()
+    stack: list[tuple[Node, bool]] = [(root, False)] if root is not None else []
+    values = 0
+    while stack:
+        node, leaving = stack.pop()
+        if leaving:
+            on_path.discard(id(node))
+            continue
+        if id(node) in on_path:
+            return Problem((), "invalid YAML: an alias (*name) refers to the block it is in, so the block would "
+                           "contain itself", "write the repeated values out, or anchor (&name) a block that does "
+                           "not hold the alias", position=_position(node))
+        values += 1
+        if values > MAX_VALUES:
+            return Problem((), f"invalid YAML: the aliases (*name) expand the file to more than {MAX_VALUES} values",
+                           "aliases repeat a block: use them for a few shared blocks, not nested in one another",
+                           position=_position(node))
+        children = _children(node)
+        if children:
+            if len(on_path) >= MAX_NESTING:
+                return _too_deep(_position(node))
+            on_path.add(id(node))
+            stack.append((node, True))
+            stack.extend((child, False) for child in reversed(children))
+    return None
+
+
+def _children(node: Node) -> list[Node]:
+    if isinstance(node, SequenceNode):
+        return list(node.value)
+    if isinstance(node, MappingNode):
+        return [part for pair in node.value for part in pair]
+    return []
 
 
 def duplicate_keys(node: Node | None, path: tuple = ()) -> list[Problem]:
@@ -165,6 +234,9 @@ def duplicate_keys(node: Node | None, path: tuple = ()) -> list[Problem]:
 
 def parse_yaml(text: str, file: str | Path) -> tuple[dict, SourceMap]:
     """(document, source map); InputError for syntax errors, duplicate keys, a non-mapping top level."""
+    too_deep = nesting_problem(text)
+    if too_deep is not None:
+        raise InputError([too_deep], file)
     try:
         root, document = _compose(text, FAST_LOADER, file)
     except yaml.YAMLError:
@@ -182,6 +254,9 @@ def _compose(text: str, loader_class, file: str | Path) -> tuple[Node | None, An
     loader = loader_class(text)
     try:
         root = loader.get_single_node()
+        expanded = alias_problem(root)
+        if expanded is not None:
+            raise InputError([expanded], file)
         problems = duplicate_keys(root)
         if problems:
             raise InputError(problems, file, SourceMap.from_node(root))

@@ -163,6 +163,10 @@ BAD_FILES = {
                                ["joint 'O' has no location", "`at:`"]),
     "top level not a mapping": (SLIDER_CRANK, "- bodies\n- joints\n", "- bodies",
                                 ["the top level must be a mapping (key: value), found a list"]),
+    "nested too deep": ("  O: [0 m, 0 m]", "  O: " + "[" * 5000 + "]" * 5000, "  O: [[",
+                        ["invalid YAML: nested more than 50 levels deep", "brackets opened and never closed"]),
+    "recursive alias": ("defaults:\n  bearing_radius: 10 mm", "defaults: &d\n  bearing_radius: *d", "defaults: &d",
+                        ["an alias (*name) refers to the block it is in"]),
 }
 
 
@@ -175,6 +179,13 @@ def test_bad_file_gives_located_message(case):
     for fragment in fragments:
         assert fragment in message, message
     assert "Value error" not in message and "pydantic" not in message
+
+
+def test_aliases_that_expand_beyond_reason_are_an_error_not_a_hang():
+    levels = ["a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
+    levels += [f"a{k}: &a{k} [" + ", ".join([f"*a{k - 1}"] * 10) + "]" for k in range(1, 5)]  # 10^5 values
+    message = load_error("\n".join(levels) + "\n" + SLIDER_CRANK)
+    assert message.startswith("sc.yaml:1:") and "the aliases (*name) expand the file to more than 100000 values" in message
 
 
 def test_empty_file():

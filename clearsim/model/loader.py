@@ -20,6 +20,7 @@ from pydantic import ValidationError
 from yaml.constructor import SafeConstructor
 from yaml.events import MappingEndEvent, MappingStartEvent, SequenceEndEvent, SequenceStartEvent
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
+from yaml.reader import ReaderError
 
 from clearsim.errors import InputError, Problem
 from clearsim.model.messages import validation_problems
@@ -132,18 +133,30 @@ _SYNTAX_HINTS = {
     "expected ',' or '}'": "a {mapping} is not closed, or an item needs quotes",
     "could not determine a constructor": "a mechanism file is plain YAML: remove the tag (!!...)",
     "expected a single document": "a mechanism file holds one YAML document: remove the extra '---'",
+    "unacceptable character": "remove this character: a YAML file holds printable text only (a stray control "
+                              "character, or a binary file)",
 }
 MAX_NESTING = 50  # levels of mappings and lists; a mechanism file needs 5 (bodies → item → points → name → [x, y])
 MAX_VALUES = 100_000  # values once aliases are expanded; a large mechanism file has a few thousand
 
 
-def _syntax_problem(exc: yaml.YAMLError) -> Problem:
+def _syntax_problem(exc: yaml.YAMLError, source: str) -> Problem:
+    if isinstance(exc, ReaderError):  # a character YAML does not allow: located by its index in the text
+        text = f"unacceptable character #x{exc.character:04x}: {exc.reason}"
+        return Problem((), f"invalid YAML: {text}", _SYNTAX_HINTS["unacceptable character"],
+                       position=text_position(source, exc.position))
     mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
     text = " ".join(str(part) for part in (getattr(exc, "context", None), getattr(exc, "problem", None)) if part)
     text = text or str(exc)
     hint = next((h for key, h in _SYNTAX_HINTS.items() if key in text), "check the YAML syntax at this line")
     position = (mark.line + 1, mark.column + 1) if mark is not None else None
     return Problem((), f"invalid YAML: {text}", hint, position=position)
+
+
+def text_position(text: str, index: int) -> tuple[int, int]:
+    """(line, column), 1-based, of a character index."""
+    line_start = text.rfind("\n", 0, index) + 1
+    return text.count("\n", 0, index) + 1, index - line_start + 1
 
 
 def _too_deep(position: tuple[int, int]) -> Problem:
@@ -243,7 +256,7 @@ def parse_yaml(text: str, file: str | Path) -> tuple[dict, SourceMap]:
         try:  # the pure-Python parser again, for its messages (the hints above know its wording)
             root, document = _compose(text, yaml.SafeLoader, file)
         except yaml.YAMLError as exc:
-            raise InputError([_syntax_problem(exc)], file) from None
+            raise InputError([_syntax_problem(exc, text)], file) from None
     source = SourceMap.from_node(root)
     _check_top_level(document, root, file, source)
     return document, source
@@ -339,12 +352,32 @@ def dump_yaml(document: dict) -> str:
 def load_mechanism(path: str | Path, overrides: Sequence[str] = ()) -> LoadedMechanism:
     """Read, override, validate and cross-check a mechanism file; InputError lists every problem."""
     path = Path(path)
+    return load_mechanism_text(read_mechanism_file(path), name=str(path), overrides=overrides, base_dir=path.parent)
+
+
+def read_mechanism_file(path: Path) -> str:
+    """The text of a mechanism file; InputError when it cannot be read or is not UTF-8 text."""
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise InputError([Problem((), f"cannot read the file: {reason}", "check the path")], path) from None
-    return load_mechanism_text(text, name=str(path), overrides=overrides, base_dir=path.parent)
+        return path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise InputError([Problem((), f"cannot read the file: {exc.strerror or exc}", "check the path")], path) from None
+    except UnicodeDecodeError:
+        raise InputError([_not_utf8(path.read_bytes())], path) from None
+
+
+def _not_utf8(data: bytes) -> Problem:
+    """The first byte that is not UTF-8, located by line and column."""
+    try:
+        data.decode("utf-8")
+        start = len(data)
+    except UnicodeDecodeError as exc:
+        start = exc.start
+    line_start = data.rfind(b"\n", 0, start) + 1
+    position = (data.count(b"\n", 0, start) + 1, len(data[line_start:start].decode("utf-8", "replace")) + 1)
+    byte = f" 0x{data[start]:02x}" if start < len(data) else ""
+    return Problem((), f"cannot read the file: it is not UTF-8 text (byte{byte})",
+                   "a mechanism file is YAML text: save it as UTF-8 (not Latin-1 or UTF-16), "
+                   "or check that this is the right file", position=position)
 
 
 def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[str] = (),

@@ -104,6 +104,15 @@ def test_missing_file_is_an_input_error(tmp_path):
         load_mechanism(tmp_path / "nowhere.yaml")
 
 
+def test_a_file_that_is_not_utf8_is_located_at_its_first_bad_byte(tmp_path):
+    config = tmp_path / "sc.yaml"
+    config.write_bytes(edited("name: slider-crank", "name: slider-crank  # caf\xe9").encode("latin-1"))
+    with pytest.raises(InputError) as info:
+        load_mechanism(config)
+    assert str(info.value).startswith(f"{config}:1:26\n  cannot read the file: it is not UTF-8 text (byte 0xe9)")
+    assert "save it as UTF-8" in str(info.value)
+
+
 def test_source_map_locates_keys_items_and_names():
     source = SourceMap.from_text(SLIDER_CRANK)
     joints_line = line_of(SLIDER_CRANK, "{name: A,")
@@ -165,6 +174,8 @@ BAD_FILES = {
                                 ["the top level must be a mapping (key: value), found a list"]),
     "nested too deep": ("  O: [0 m, 0 m]", "  O: " + "[" * 5000 + "]" * 5000, "  O: [[",
                         ["invalid YAML: nested more than 50 levels deep", "brackets opened and never closed"]),
+    "control character": ("  O: [0 m, 0 m]", "  O: [0 m, 0\x07 m]", "\x07",
+                          ["invalid YAML: unacceptable character #x0007", "printable text only"]),
     "recursive alias": ("defaults:\n  bearing_radius: 10 mm", "defaults: &d\n  bearing_radius: *d", "defaults: &d",
                         ["an alias (*name) refers to the block it is in"]),
 }

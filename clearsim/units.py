@@ -7,6 +7,7 @@ expected, and "5000 rpm" converts to rad/s.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Annotated, Any
@@ -83,7 +84,7 @@ def parse_quantity(value: Any):
     if isinstance(value, bool):
         raise UnitError(f"expected a number with a unit, got {value!r}")
     if isinstance(value, (int, float)):
-        return registry().Quantity(float(value))
+        return registry().Quantity(_check_finite(value, value))
     if not isinstance(value, str):
         raise UnitError(f"expected a number or a 'value unit' string, got {value!r}")
     pint = _import_pint()
@@ -96,7 +97,20 @@ def parse_quantity(value: Any):
         raise UnitError(f"cannot read {value!r} as 'value unit' (e.g. '0.01 mm')") from None
     if not hasattr(quantity, "magnitude") or not isinstance(quantity.magnitude, (int, float)):
         raise UnitError(f"cannot read {value!r} as a number with a unit")
+    _check_finite(quantity.magnitude, value)
     return quantity
+
+
+def _check_finite(number: float | int, value: Any) -> float:
+    """The number as a float, unless it is NaN or infinite (written as nan or inf, or beyond ±1.8e308)."""
+    try:
+        number = float(number)
+    except OverflowError:  # an integer too large for a float
+        number = math.inf
+    if not math.isfinite(number):
+        shown = repr(value) if len(repr(value)) <= 60 else repr(value)[:57] + "..."
+        raise UnitError(f"expected a finite number, got {shown}")
+    return number
 
 
 def _has_unit(quantity) -> bool:
@@ -125,7 +139,7 @@ def _to_si(value: Any, kind: str) -> float:
         raise UnitError(
             f"expected a {dimension.name} (e.g. '{dimension.example}'), got {value!r} [{found}]"
         )
-    return float(quantity.to_base_units().magnitude)
+    return _check_finite(quantity.to_base_units().magnitude, value)
 
 
 def contact_stiffness_to_si(value: Any, exponent: float) -> float:
@@ -136,7 +150,7 @@ def contact_stiffness_to_si(value: Any, exponent: float) -> float:
         raise UnitError(
             f"expected a contact stiffness in N/m^{exponent:g} for exponent n = {exponent:g}, got {value!r}"
         )
-    return float(quantity.to_base_units().magnitude)
+    return _check_finite(quantity.to_base_units().magnitude, value)
 
 
 def _si_validator(kind: str):

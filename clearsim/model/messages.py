@@ -23,7 +23,7 @@ _BOUNDS = {
 }
 
 _EXPECTED = {
-    "float_type": "a number", "float_parsing": "a number", "int_type": "a whole number",
+    "float_type": "a number", "float_parsing": "a number", "finite_number": "a finite number", "int_type": "a whole number",
     "int_parsing": "a whole number", "int_from_float": "a whole number", "string_type": "a name (text)",
     "bool_type": "true or false", "bool_parsing": "true or false", "tuple_type": "a list",
     "list_type": "a list", "dict_type": "a mapping (key: value)", "model_type": "a mapping (key: value)",

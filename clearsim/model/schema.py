@@ -38,7 +38,7 @@ PointRef = Union[str, Point]  # a named point, or [x, y]
 
 
 class Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)  # nan and inf are no one's intended value
 
 
 def _unit_vector(value: Direction) -> Direction:

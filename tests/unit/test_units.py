@@ -59,3 +59,19 @@ def test_unknown_unit_is_an_error():
 def test_a_boolean_is_not_a_number():
     with pytest.raises(UnitError):
         to_si(True, "length")
+
+
+@pytest.mark.parametrize("value, kind", [
+    (math.nan, "length"), (math.inf, "mass"), ("nan mm", "length"), ("-inf N", "force"),
+    ("1e400 m", "length"),  # beyond floating point as written
+    ("1e307 km", "length"),  # beyond floating point once converted to SI
+    (10**400, "time"),  # an integer too large for a float
+], ids=["nan", "inf", "nan mm", "-inf N", "1e400 m", "1e307 km", "10**400"])
+def test_a_value_that_is_not_a_finite_number_is_an_error(value, kind):
+    with pytest.raises(UnitError, match="expected a finite number"):
+        to_si(value, kind)
+
+
+def test_a_contact_stiffness_that_is_not_finite_is_an_error():
+    with pytest.raises(UnitError, match="expected a finite number"):
+        contact_stiffness_to_si("inf N/m^1.5", 1.5)

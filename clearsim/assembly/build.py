@@ -131,7 +131,13 @@ class Laws:
 
 def _motion_law(driver: schema.Driver, kind: str, base_dir: Path, path) -> motion.PiecewisePolynomial:
     """The driver's law in SI units of its coordinate (kind 'length' or 'angle'), through the actuator's lag."""
-    return motion.lagged(_written_law(driver, kind, base_dir, path), driver.lag)
+    law = _written_law(driver, kind, base_dir, path)
+    try:
+        return motion.lagged(law, driver.lag)
+    except (ValueError, ArithmeticError):
+        raise BuildError([Problem(path + ("lag",), f"the motion seen through a lag of {driver.lag:g} s exceeds the "
+                                  "range of floating-point numbers", "a lag is a fraction of the motion's time scale, "
+                                  "e.g. 2 ms: check the value and its unit")]) from None
 
 
 def _written_law(driver: schema.Driver, kind: str, base_dir: Path, path) -> motion.PiecewisePolynomial:
@@ -153,6 +159,10 @@ def _written_law(driver: schema.Driver, kind: str, base_dir: Path, path) -> moti
         raise BuildError([Problem(path + ("motion",), str(exc), f"the driven coordinate is a {kind}")]) from None
     except ValueError as exc:
         raise BuildError([Problem(path + ("motion",), str(exc), None)]) from None
+    except ArithmeticError:  # e.g. a stroke over a duration of 1e-300 s
+        raise BuildError([Problem(path + ("motion",), "the motion law exceeds the range of floating-point numbers",
+                                  "check its values and their units: a duration far too short, or values far "
+                                  "too large")]) from None
 
 
 def add_joint(rows: ConstraintRows, clearances: list, poses: Poses, joint, defaults, path) -> None:

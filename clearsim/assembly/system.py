@@ -74,9 +74,9 @@ def _loads(mechanism, poses: Poses, laws: Laws, base_dir: Path) -> list:
         try:
             times, values = read_table_column(base_dir / force.file, force.time_column, force.value_column,
                                               force.time_unit, force.value_unit, "force", path)
+            law = laws.add(motion.table_law(times, values, relative=False))
         except ValueError as exc:
             raise BuildError([Problem(path + ("file",), str(exc), None)]) from None
-        law = laws.add(motion.table_law(times, values, relative=False))
         loads.append((body, [*point, *force.direction, 0.0], law))
     return loads
 

@@ -8,6 +8,7 @@ that all problems of a file are reported together, each with its location.
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Literal, Union
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
@@ -42,7 +43,7 @@ class Strict(BaseModel):
 
 
 def _unit_vector(value: Direction) -> Direction:
-    norm = (value[0] ** 2 + value[1] ** 2) ** 0.5
+    norm = math.hypot(*value)  # no overflow for components beyond 1e154
     if norm < 1e-12:
         raise ValueError("a direction must not be the zero vector")
     return (value[0] / norm, value[1] / norm)

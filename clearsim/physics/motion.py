@@ -51,15 +51,26 @@ def polynomial_law(coefficients_from_first_power) -> PiecewisePolynomial:
 
 def table_law(times: np.ndarray, values: np.ndarray, relative: bool = True) -> PiecewisePolynomial:
     """Cubic spline through (t_i, s_i), held constant after the last sample; relative: s(t_0) = 0."""
-    from scipy.interpolate import CubicSpline
-
     values = np.asarray(values, dtype=float) - (values[0] if relative else 0.0)
-    spline = CubicSpline(np.asarray(times, dtype=float), values, bc_type="not-a-knot")
+    spline = _spline(np.asarray(times, dtype=float), values)
     pieces = [_pad(spline.c[::-1, p]) for p in range(spline.c.shape[1])]
     breaks = list(spline.x[:-1])
     breaks.append(spline.x[-1])
     pieces.append(_pad([values[-1]]))
     return PiecewisePolynomial(np.array(breaks), np.array(pieces))
+
+
+def _spline(times: np.ndarray, values: np.ndarray):
+    """The not-a-knot cubic spline; ValueError when its slopes or coefficients exceed floating-point numbers."""
+    from scipy.interpolate import CubicSpline
+
+    with np.errstate(over="ignore", invalid="ignore"):
+        finite = np.all(np.isfinite(np.diff(values) / np.diff(times)))
+        spline = CubicSpline(times, values, bc_type="not-a-knot") if finite else None
+    if spline is None or not np.all(np.isfinite(spline.c)):
+        raise ValueError("the samples change faster than floating-point numbers can hold (a slope beyond 1.8e308): "
+                         "check the units of the time and value columns")
+    return spline
 
 
 def lagged(law: PiecewisePolynomial, lag: float, samples: int = 1200) -> PiecewisePolynomial:

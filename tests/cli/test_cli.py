@@ -112,6 +112,27 @@ def test_bad_mechanisms_give_one_located_message_and_exit_2(tmp_path, text, expe
     assert not out.exists()
 
 
+@pytest.mark.parametrize("override, place", [
+    ("drivers.crank_drive.motion={law: stroke, stroke: 1, duration: 1e-300 s}", "drivers[0] 'crank_drive' → motion"),
+    ("drivers.crank_drive.lag=1e300 s", "drivers[0] 'crank_drive' → lag"),
+], ids=["stroke", "lag"])
+def test_a_motion_beyond_floating_point_exits_2_at_its_driver(override, place):
+    result = invoke("validate", SLIDER_CRANK, "--set", override)
+    assert result.exit_code == 2, result.output
+    assert f"in --set {override}  {place}\n" in result.output and "exceeds the range of floating-point" in result.output
+
+
+def test_a_force_table_too_steep_for_a_spline_exits_2_at_its_file(tmp_path):
+    config = tmp_path / "sc.yaml"
+    config.write_text(Path(SLIDER_CRANK).read_text()
+                      + "forces:\n  - {type: tabulated, name: kick, body: slider, direction: [1, 0], file: kick.csv}\n")
+    (tmp_path / "kick.csv").write_text("0,0\n1e-300,1e300\n")
+    result = invoke("validate", config)
+    assert result.exit_code == 2, result.output
+    assert f"{config}:{len(config.read_text().splitlines())}:" in result.output
+    assert "forces[0] 'kick' → file\n  the samples change faster than floating-point numbers can hold" in result.output
+
+
 def test_solver_failure_exits_2_with_time_and_joint_and_keeps_partial_results(tmp_path):
     out = tmp_path / "failed.h5"
     result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=3ms", "--set", "solver.min_step=2e-5s")

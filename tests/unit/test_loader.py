@@ -204,6 +204,11 @@ def test_aliases_that_expand_beyond_reason_are_an_error_not_a_hang():
     assert message.startswith("sc.yaml:1:") and "the aliases (*name) expand the file to more than 100000 values" in message
 
 
+def test_a_direction_with_huge_components_is_normalised():
+    m = load_mechanism_text(edited("axis: [1, 0]", "axis: [1e200, 1e200]")).mechanism
+    assert m.joint("guide").axis == pytest.approx((math.sqrt(0.5), math.sqrt(0.5)))
+
+
 def test_empty_file():
     assert "sc.yaml:1:1\n  the file is empty" in load_error("# nothing here\n")
 

@@ -127,15 +127,15 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                      run.warnings() if run is not None else [])
 
 
-def element_place(loaded: LoadedMechanism, element: str | None) -> str | None:
-    """Where the joint or driver a solver failure names is in the mechanism file: "file:line:column  joints[k] 'J'"."""
+def element_place(loaded: LoadedMechanism, element: str | None) -> str:
+    """Where the joint or driver a solver failure names is in the mechanism file: "file:line:column  joints[k] 'J'";
+    a failure that names neither is placed at the file's `solver:` settings, whose limits stopped the run."""
     name = (element or "").split(" (")[0]
-    for path, item in loaded.source.names.items():
-        if len(path) == 2 and path[0] in ("joints", "drivers") and item == name:
-            position = loaded.source.locate(path)[0]
-            at = f"{loaded.path}:{position[0]}:{position[1]}" if position else str(loaded.path)
-            return f"{at}  {format_path(path, loaded.source.names)}"
-    return None
+    path = next((path for path, item in loaded.source.names.items()
+                 if len(path) == 2 and path[0] in ("joints", "drivers") and item == name), ("solver",))
+    position = loaded.source.locate(path)[0]
+    at = f"{loaded.path}:{position[0]}:{position[1]}" if position else str(loaded.path)
+    return f"{at}  {format_path(path, loaded.source.names)}"
 
 
 def result_file_bytes(system: System) -> float:

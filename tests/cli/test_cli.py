@@ -145,6 +145,15 @@ def test_solver_failure_exits_2_with_time_and_joint_and_keeps_partial_results(tm
         assert not f.attrs["complete"] and f["time"].shape[0] > 1
 
 
+def test_solver_failure_without_a_joint_is_placed_at_the_solver_settings(tmp_path):
+    out = tmp_path / "failed.h5"
+    result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=1ms", "--set", "bodies.crank.mass=1e300")
+    assert result.exit_code == 2, result.output
+    line = next(number for number, text in enumerate(Path(SLIDER_CRANK).read_text().splitlines(), 1)
+                if text.startswith("solver:"))
+    assert f"error: {SLIDER_CRANK}:{line}:9  solver: at t = 0 ms: the step size fell below solver.min_step" in result.output
+
+
 def test_sigterm_leaves_a_flagged_readable_file(tmp_path):
     out = tmp_path / "killed.h5"
     command = [sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out),

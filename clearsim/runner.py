@@ -94,7 +94,9 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     backup = keep_existing(output)
     run = None  # made inside the try: loading the compiled kernels can take seconds, and may be interrupted
     episodes, status, complete, error = [], "complete", True, None
-    with ResultWriter(output, loaded.resolved_yaml, _attributes(system, loaded)) as writer:
+    # a state that overflows (absurd masses, speeds, forces) is reported once, by the solver's failure message,
+    # not also by numpy's warnings from every place its samples pass through
+    with np.errstate(all="ignore"), ResultWriter(output, loaded.resolved_yaml, _attributes(system, loaded)) as writer:
         pending = _PendingChunks(writer, episodes, system)
         try:
             run = Run(system)

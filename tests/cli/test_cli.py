@@ -6,6 +6,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import h5py
@@ -152,6 +153,16 @@ def test_solver_failure_without_a_joint_is_placed_at_the_solver_settings(tmp_pat
     line = next(number for number, text in enumerate(Path(SLIDER_CRANK).read_text().splitlines(), 1)
                 if text.startswith("solver:"))
     assert f"error: {SLIDER_CRANK}:{line}:9  solver: at t = 0 ms: the step size fell below solver.min_step" in result.output
+
+
+def test_a_run_that_overflows_reports_the_failure_without_numpy_warnings(tmp_path):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = invoke("run", SLIDER_CRANK, "-o", tmp_path / "overflow.h5", "--set", "solver.t_end=1ms",
+                        "--set", "drivers.crank_drive.motion={law: polynomial, coefficients: [1e300, 1e300]}")
+    assert result.exit_code == 2, result.output
+    assert "at t = 0 ms: the step size fell below solver.min_step" in result.output
+    assert [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)] == []
 
 
 def test_sigterm_leaves_a_flagged_readable_file(tmp_path):

@@ -203,6 +203,7 @@ class Summary:
 
 
 SUMMARY_JOINT_DATASETS = ("/normal_force", "/mode", "/stick")
+NO_SAMPLES = np.zeros(0)
 
 
 def summarize(path: Path) -> Summary:
@@ -215,10 +216,10 @@ def summarize(path: Path) -> Summary:
         key = f"sensors/{name}"
         peak[role] = (name, float(np.max(np.abs(data[key])))) if name and key in data and len(data[key]) else None
     joints = [j for j in str(data["attrs"].get("clearance_joints", "")).split(",") if j]
-    forces = {j: _peak_contact_force(path, j, data[f"joints/{j}/normal_force"]) for j in joints}
+    forces = {j: _peak_contact_force(path, j, data.get(f"joints/{j}/normal_force", NO_SAMPLES)) for j in joints}
     shares = {}
     for j in joints:
-        mode = data[f"joints/{j}/mode"]
+        mode = data.get(f"joints/{j}/mode", NO_SAMPLES)  # none in a run stopped before its first sample
         shares[j] = tuple(float(np.mean(mode == m)) if len(mode) else 0.0 for m in (0, 1, 2))
     sticking = {j: float(np.mean(data[f"joints/{j}/stick"][data[f"joints/{j}/mode"] > 0]))
                 for j in joints if f"joints/{j}/stick" in data and np.any(data[f"joints/{j}/mode"] > 0)}

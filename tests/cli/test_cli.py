@@ -165,6 +165,22 @@ def test_a_run_that_overflows_reports_the_failure_without_numpy_warnings(tmp_pat
     assert [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)] == []
 
 
+def test_a_run_interrupted_before_its_first_sample_exits_130_without_traceback(tmp_path, monkeypatch):
+    from clearsim.solver.simulate import Run
+
+    def interrupted(self):
+        raise KeyboardInterrupt
+        yield  # a generator, as Run.chunks is
+
+    monkeypatch.setattr(Run, "chunks", interrupted)
+    out = tmp_path / "interrupted.h5"
+    result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=1ms")
+    assert result.exit_code == 130, result.output
+    assert "interrupted" in result.output and not isinstance(result.exception, KeyError)
+    with h5py.File(out) as f:
+        assert not f.attrs["complete"] and "time" not in f
+
+
 def test_sigterm_leaves_a_flagged_readable_file(tmp_path):
     out = tmp_path / "killed.h5"
     command = [sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out),

@@ -23,8 +23,8 @@ from clearsim import __version__
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="Planar mechanisms with clearance joints: simulate, sweep, plot, diagnose.")
-console = Console()
-errors = Console(stderr=True)
+console = Console(emoji=False)  # no emoji codes: "run.yaml:100:9" would print as "run.yaml💯9"
+errors = Console(stderr=True, emoji=False)
 _state = {"debug": False}
 
 INPUT_ERROR = 2

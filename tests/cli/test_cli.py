@@ -181,6 +181,13 @@ def test_a_run_interrupted_before_its_first_sample_exits_130_without_traceback(t
         assert not f.attrs["complete"] and "time" not in f
 
 
+def test_a_place_at_line_100_prints_as_written_not_as_an_emoji(tmp_path):
+    config = tmp_path / "long.yaml"
+    config.write_text("#\n" * 99 + "- not a mapping\n")
+    result = invoke("validate", config)
+    assert result.exit_code == 2 and f"{config}:100:1\n  the top level must be a mapping" in result.output, result.output
+
+
 def test_sigterm_leaves_a_flagged_readable_file(tmp_path):
     out = tmp_path / "killed.h5"
     command = [sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out),

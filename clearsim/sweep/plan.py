@@ -72,6 +72,8 @@ def _check_request(request: SweepRequest) -> None:
         raise SweepOptionError("--joints names the joints of --clearance: give --clearance too")
     if request.sample is not None and request.sample < 1:
         raise SweepOptionError(f"--sample must be at least 1, got {request.sample}")
+    if request.seed < 0:
+        raise SweepOptionError(f"--seed must be 0 or more, got {request.seed}")
 
 
 def _grid(request: SweepRequest, mechanism, fixed, swept) -> tuple[list[Case], list[str]]:

@@ -157,6 +157,7 @@ def test_a_tolerance_whose_value_does_not_fit_its_path_is_reported_at_the_tolera
     (["--sample", "3"], "declares no `tolerances:`"),
     (["--clearance", "0.1", "--workers", "0"], "error: --workers must be at least 1, got 0"),
     (["--clearance", "0.1", "--delay-fraction", "1.5"], "error: --delay-fraction must be between 0 and 1, got 1.5"),
+    (["--sample", "3", "--seed", "-1"], "error: --seed must be 0 or more, got -1"),
 ])
 def test_bad_options_exit_2_with_one_clear_message_and_write_nothing(tmp_path, options, message):
     out = tmp_path / "sweep"

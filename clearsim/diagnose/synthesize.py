@@ -69,6 +69,8 @@ def _quantity(text: str, kind: str, option: str) -> float:
 
 
 def _settings(request: SynthesisRequest) -> tuple[float, float | None, float]:
+    if request.seed < 0:
+        raise SynthesisError(f"--seed {request.seed}: the seed must be 0 or more")
     rate = _quantity(request.rate, "frequency", "--rate")
     if rate <= 0.0:
         raise SynthesisError(f"--rate {request.rate!r}: the sampling rate must be positive, e.g. --rate 15kHz")

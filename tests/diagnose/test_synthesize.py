@@ -104,6 +104,7 @@ def test_refuses_to_overwrite_unless_forced(tmp_path):
     (["--noise", "0.1 N"], "--noise '0.1 N' for sensor 'slider_displacement' [m]: expected a length"),
     (["--noise", "lots%"], "--noise 'lots%': expected a percentage such as 1% or a value with a unit"),
     (["--set", "solver.t_end=0.5ms"], "only 8 samples at 15000 Hz over the run and trigger offset"),
+    (["--seed", "-1"], "--seed -1: the seed must be 0 or more"),
 ])
 def test_bad_options_exit_2_with_the_message(tmp_path, options, message):
     result = invoke("synthesize", SLIDER_CRANK, *SHORT, "-o", tmp_path / "bench.csv", *options)

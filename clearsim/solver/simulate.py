@@ -199,7 +199,7 @@ class Run:
                 return
             if status == ig.CHUNK_END:
                 next_stop = min(t_end, next_stop + t_end / CHUNKS)
-            elif status not in (ig.BUFFER_FULL,):
+            elif status not in (ig.BUFFER_FULL, ig.PAUSED):
                 raise self._failure(status)
 
     def _failure(self, status: int) -> SolverError:

@@ -14,6 +14,7 @@ import pytest
 from typer.testing import CliRunner
 
 from clearsim import __version__
+from clearsim.runner import simulate_config
 from clearsim.cli import app
 
 CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
@@ -188,7 +189,13 @@ def test_a_place_at_line_100_prints_as_written_not_as_an_emoji(tmp_path):
     assert result.exit_code == 2 and f"{config}:100:1\n  the top level must be a mapping" in result.output, result.output
 
 
-def test_sigterm_leaves_a_flagged_readable_file(tmp_path):
+@pytest.fixture
+def warm_kernels(tmp_path):
+    """A run first, so that the process signalled below is integrating, not compiling, when the signal comes."""
+    simulate_config(SLIDER_CRANK, ["solver.t_end=1ms"], tmp_path / "warm-up.h5")
+
+
+def test_sigterm_leaves_a_flagged_readable_file(tmp_path, warm_kernels):
     out = tmp_path / "killed.h5"
     command = [sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out),
                "--set", "solver.t_end=2s", "--set", "solver.output_rate=10kHz"]
@@ -204,6 +211,27 @@ def test_sigterm_leaves_a_flagged_readable_file(tmp_path):
     with h5py.File(out) as f:
         assert not f.attrs["complete"] and str(f.attrs["status"]).startswith("interrupted")
         assert 0.0 < f["time"][-1] < 2.0
+
+
+def test_a_run_with_a_tiny_max_step_can_still_be_stopped(tmp_path, warm_kernels):
+    """2.4e9 steps would take hours; the compiled loop comes back to Python every STEPS_PER_CALL steps, where
+    SIGTERM and Ctrl-C are handled (it used to return only at each hundredth of t_end: minutes here)."""
+    out = tmp_path / "tiny-steps.h5"
+    command = [sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out),
+               "--set", "solver.max_step=1e-11s"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=os.environ.copy())
+    deadline = time.time() + 120
+    while not out.exists() and time.time() < deadline and process.poll() is None:
+        time.sleep(0.2)
+    time.sleep(1.0)
+    process.send_signal(signal.SIGTERM)
+    try:
+        _, stderr = process.communicate(timeout=30)
+    finally:
+        process.kill()
+    assert process.returncode == 130, stderr.decode()
+    with h5py.File(out) as f:
+        assert not f.attrs["complete"] and str(f.attrs["status"]).startswith("interrupted")
 
 
 from tests.unit.test_loader import BAD_FILES, edited  # noqa: E402  (the same bad files, through the CLI)

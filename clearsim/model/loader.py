@@ -380,11 +380,27 @@ def _not_utf8(data: bytes) -> Problem:
                    "or check that this is the right file", position=position)
 
 
+def boolean_problems(value: Any, path: tuple = ()) -> list[Problem]:
+    """true/false anywhere in a mechanism file, where no setting takes one (pydantic would read true as 1)."""
+    if isinstance(value, bool):
+        return [Problem(path, f"expected a number, a value with a unit or a name, got {str(value).lower()}",
+                        "YAML reads true, false, yes, no, on and off unquoted as true/false: write the number, "
+                        "or quote a name that is one of these words")]
+    if isinstance(value, dict):
+        return [problem for key, item in value.items() for problem in boolean_problems(item, path + (key,))]
+    if isinstance(value, list):
+        return [problem for index, item in enumerate(value) for problem in boolean_problems(item, path + (index,))]
+    return []
+
+
 def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[str] = (),
                         base_dir: Path | None = None) -> LoadedMechanism:
     """As load_mechanism, from YAML text (`name` is used in messages)."""
     document, source = parse_yaml(text, name)
     source.overrides, problems = apply_overrides(document, list(overrides), Mechanism)
+    booleans = boolean_problems(document)
+    if booleans:  # alone: validation would also reject each (as 1, or as not a name) in its own words
+        raise InputError(problems + booleans, name, source)
     mechanism = None
     try:
         mechanism = Mechanism.model_validate(document)

@@ -114,6 +114,12 @@ def start_if_cold() -> None:
     atexit.register(_stop_helper)
 
 
+def reap_helper() -> None:
+    """Collect the helper's exit status once it has finished (else it stays a zombie until this process exits)."""
+    if _helper is not None:
+        _helper.poll()
+
+
 def _stop_helper() -> None:
     """At exit: what the helper has written stays in the cache; it is not left running behind the run."""
     if _helper is not None and _helper.poll() is None:

@@ -168,6 +168,7 @@ class Run:
                    self.episode_of, *self.log, self.peak_force, *self.buffers, t_stop)
         if self.ints[ig.I_STATUS] == ig.FIRST_STEP:  # the first call: loads (or compiles) the loop, one rhs
             self.kernel_time += clock.perf_counter() - started
+            precompile.reap_helper()
         else:
             self.wall_time += clock.perf_counter() - started
 

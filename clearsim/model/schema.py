@@ -240,7 +240,7 @@ class SpringDamper(Strict):
     points: tuple[str, str] | None = Field(None, description="the two ends as named body points")
     stiffness: SpringStiffness = Field(0.0, description="spring rate k")
     damping: Damping = Field(0.0, description="damping coefficient c")
-    free_length: Length | None = Field(None, description="ℓ0; default: the length at t = 0")
+    free_length: Length | None = Field(None, ge=0.0, description="ℓ0; default: the length at t = 0")
     preload: Force = Field(0.0, description="constant tension added to the spring force")
 
 

@@ -104,6 +104,12 @@ def test_missing_file_is_an_input_error(tmp_path):
         load_mechanism(tmp_path / "nowhere.yaml")
 
 
+def test_a_spring_with_a_negative_free_length_is_an_error():
+    spring = "forces:\n  - {type: spring_damper, name: s, bodies: [ground, slider], stiffness: 1e4 N/m, free_length: -1 m}\n"
+    message = load_error(SLIDER_CRANK + spring)
+    assert "forces[0] 's' → free_length\n  must be at least 0, got '-1 m'" in message, message
+
+
 def test_a_file_that_is_not_utf8_is_located_at_its_first_bad_byte(tmp_path):
     config = tmp_path / "sc.yaml"
     config.write_bytes(edited("name: slider-crank", "name: slider-crank  # caf\xe9").encode("latin-1"))

@@ -195,30 +195,10 @@ def warm_kernels(tmp_path):
     simulate_config(SLIDER_CRANK, ["solver.t_end=1ms"], tmp_path / "warm-up.h5")
 
 
-def test_sigterm_leaves_a_flagged_readable_file(tmp_path, warm_kernels):
-    out = tmp_path / "killed.h5"
-    command = [sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out),
-               "--set", "solver.t_end=2s", "--set", "solver.output_rate=10kHz"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=os.environ.copy())
-    deadline = time.time() + 120
-    while not out.exists() and time.time() < deadline and process.poll() is None:
-        time.sleep(0.2)
-    time.sleep(1.0)
-    process.send_signal(signal.SIGTERM)
-    _, stderr = process.communicate(timeout=60)
-    assert process.returncode == 130, stderr.decode()
-    assert b"Traceback" not in stderr
-    with h5py.File(out) as f:
-        assert not f.attrs["complete"] and str(f.attrs["status"]).startswith("interrupted")
-        assert 0.0 < f["time"][-1] < 2.0
-
-
-def test_a_run_with_a_tiny_max_step_can_still_be_stopped(tmp_path, warm_kernels):
-    """2.4e9 steps would take hours; the compiled loop comes back to Python every STEPS_PER_CALL steps, where
-    SIGTERM and Ctrl-C are handled (it used to return only at each hundredth of t_end: minutes here)."""
-    out = tmp_path / "tiny-steps.h5"
-    command = [sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out),
-               "--set", "solver.max_step=1e-11s"]
+def _stopped_run(out: Path, *overrides: str) -> tuple[int, bytes]:
+    """`clearsim run` in a process sent SIGTERM a second after its result file appears: (exit code, stderr)."""
+    command = [sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out)]
+    command += [part for override in overrides for part in ("--set", override)]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=os.environ.copy())
     deadline = time.time() + 120
     while not out.exists() and time.time() < deadline and process.poll() is None:
@@ -229,7 +209,25 @@ def test_a_run_with_a_tiny_max_step_can_still_be_stopped(tmp_path, warm_kernels)
         _, stderr = process.communicate(timeout=30)
     finally:
         process.kill()
-    assert process.returncode == 130, stderr.decode()
+    return process.returncode, stderr
+
+
+def test_sigterm_leaves_a_flagged_readable_file(tmp_path, warm_kernels):
+    out = tmp_path / "killed.h5"
+    code, stderr = _stopped_run(out, "solver.t_end=2s", "solver.output_rate=10kHz")
+    assert code == 130, stderr.decode()
+    assert b"Traceback" not in stderr
+    with h5py.File(out) as f:
+        assert not f.attrs["complete"] and str(f.attrs["status"]).startswith("interrupted")
+        assert 0.0 < f["time"][-1] < 2.0
+
+
+def test_a_run_with_a_tiny_max_step_can_still_be_stopped(tmp_path, warm_kernels):
+    """2.4e9 steps would take hours; the compiled loop comes back to Python every STEPS_PER_CALL steps, where
+    SIGTERM and Ctrl-C are handled (it used to return only at each hundredth of t_end: minutes here)."""
+    out = tmp_path / "tiny-steps.h5"
+    code, stderr = _stopped_run(out, "solver.max_step=1e-11s")
+    assert code == 130, stderr.decode()
     with h5py.File(out) as f:
         assert not f.attrs["complete"] and str(f.attrs["status"]).startswith("interrupted")
 

@@ -14,6 +14,7 @@ import uuid
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Callable, Sequence
 
+from clearsim.solver import precompile
 from clearsim.sweep.grid import SweepOptionError
 from clearsim.sweep.worker import FAILED, CaseOutcome, CaseTask, init_pool_worker
 
@@ -79,12 +80,21 @@ class LocalPool:
         kept = self._pool is not None
         pool, stop = (self._pool, self._stop) if kept else self._start(min(self.workers, len(tasks)))
         stop.clear()
-        futures = {pool.submit(function, task): task for task in tasks}
+        # on an empty kernel cache the first case runs alone: its process compiles the kernels (with the
+        # compile-ahead helper on the second core) and every other case loads them, instead of each process
+        # compiling them at once on shared cores (a 2-worker sweep's first cases: 17 → 13 s)
+        held_back = list(tasks[1:]) if len(tasks) > 1 and self.workers > 1 and precompile.cache_is_cold() else []
+        futures = {pool.submit(function, task): task for task in tasks[:len(tasks) - len(held_back)]}
         remaining, interrupted = set(futures), False
         try:
             while remaining:
                 try:
                     _collect_finished(futures, remaining, collect)
+                    if held_back and not interrupted:
+                        submitted = {pool.submit(function, task): task for task in held_back}
+                        futures.update(submitted)
+                        remaining.update(submitted)
+                        held_back = []
                 except KeyboardInterrupt:
                     if interrupted:
                         raise  # a second Ctrl-C: leave without waiting for the running cases

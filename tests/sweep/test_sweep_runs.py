@@ -175,3 +175,45 @@ def test_a_case_run_at_a_tolerance_too_coarse_for_its_contacts_is_named_with_its
     assert "not resolved by the solver tolerance" in rows[warned[0]]["warnings"]
     assert f"warning: 1 case with results the solver could not vouch for ({warned[0]})" in result.output
     assert all(not row["warnings"] for row in read_summary(pool_sweep[0]).values())  # default tolerances: none
+
+
+# --- an empty kernel cache: the first case alone ---------------------------------------------------------------
+
+
+class _ThreadPool:
+    """LocalPool's pool in threads, for the order of starts and ends (cases here are plain functions)."""
+
+    def __init__(self, workers: int):
+        import threading
+        from concurrent.futures import ThreadPoolExecutor
+
+        self.executor, self.stop = ThreadPoolExecutor(workers), threading.Event()
+
+
+@pytest.mark.parametrize("cold", [True, False], ids=["empty cache", "filled cache"])
+def test_on_an_empty_kernel_cache_the_first_case_runs_alone(monkeypatch, cold):
+    import threading
+    import time
+
+    from clearsim.solver import precompile
+    from clearsim.sweep import executors
+    from clearsim.sweep.worker import COMPLETE, CaseOutcome
+
+    events, lock = [], threading.Lock()
+
+    def case(task):
+        with lock:
+            events.append(("start", task))
+        time.sleep(0.2)
+        with lock:
+            events.append(("end", task))
+        return CaseOutcome(task, COMPLETE, True, "")
+
+    monkeypatch.setattr(precompile, "cache_is_cold", lambda: cold)
+    monkeypatch.setattr(executors.LocalPool, "_start", staticmethod(
+        lambda workers: (lambda pool: (pool.executor, pool.stop))(_ThreadPool(workers))))
+    collected = []
+    assert not LocalPool(2).run(case, ["a", "b", "c"], collected.append)
+    assert sorted(outcome.name for outcome in collected) == ["a", "b", "c"]
+    first_end, second_start = events.index(("end", "a")), min(events.index(("start", "b")), events.index(("start", "c")))
+    assert (first_end < second_start) == cold  # cold: b and c wait for a; filled: they start beside it

@@ -95,6 +95,15 @@ def _progress_bar(t_end: float):
     return progress, lambda t: progress.update(task, completed=t, now=t * 1e3)
 
 
+def _announce_compile() -> None:
+    """Say why the first run of a version waits before its progress bar moves."""
+    from clearsim.solver.precompile import cache_is_cold
+
+    if cache_is_cold():
+        errors.print("compiling the numerical kernels: the first run of this clearsim version on this machine "
+                     "(about 15 s; later runs load them)", soft_wrap=True)
+
+
 def _summary_table(report, summary) -> Table:
     table = Table(show_header=False, box=None, pad_edge=False)
     stats = report.statistics
@@ -129,6 +138,7 @@ def run(
     from clearsim.model.loader import load_mechanism
 
     loaded = load_mechanism(config or BUNDLED_CONFIG, overrides)
+    _announce_compile()
     system = prepare(loaded)
     progress, update = _progress_bar(system.mechanism.solver.t_end)
     with progress:
@@ -180,6 +190,8 @@ def sweep(
     plan = plan_sweep(request, BUNDLED_CONFIG)
     executor = DaskCluster(scheduler, workers) if scheduler else LocalPool(workers)
     console.print(display.opening_line(plan, executor.describe()), soft_wrap=True)
+    if not scheduler:
+        _announce_compile()
     progress, update = display.case_progress(errors, len(plan.cases))
     try:
         with progress:

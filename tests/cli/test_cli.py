@@ -42,6 +42,17 @@ def test_run_writes_the_file_and_prints_the_summary(tmp_path):
         assert bool(f.attrs["complete"]) and f["time"][-1] == pytest.approx(0.002)
 
 
+@pytest.mark.parametrize("cold", [True, False], ids=["empty cache", "filled cache"])
+def test_a_first_run_says_that_it_compiles(tmp_path, monkeypatch, cold):
+    from clearsim.solver import precompile
+
+    monkeypatch.setattr(precompile, "cache_is_cold", lambda: cold)
+    monkeypatch.setenv(precompile.DISABLE_VARIABLE, "0")  # no helper process from a pretended empty cache
+    result = invoke("run", SLIDER_CRANK, "-o", tmp_path / "sc.h5", "--set", "solver.t_end=1ms")
+    assert result.exit_code == 0, result.output
+    assert ("compiling the numerical kernels" in result.output) == cold
+
+
 def test_run_prints_the_warning_of_an_unresolved_contact_and_exits_0(tmp_path):
     out = tmp_path / "coarse.h5"
     result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.rtol=1e-4", "--set", "solver.atol=1e-7")

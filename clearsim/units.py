@@ -8,8 +8,11 @@ expected, and "5000 rpm" converts to rad/s.
 from __future__ import annotations
 
 import math
+import os
+import re
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 from typing import Annotated, Any
 
 from pydantic import BeforeValidator, WithJsonSchema
@@ -21,8 +24,25 @@ class UnitError(ValueError):
 
 @lru_cache(maxsize=1)
 def registry():
-    """The shared pint registry (created on first use: it takes a few tenths of a second)."""
-    return _import_pint().UnitRegistry()
+    """The shared pint registry, created on first use from pint's definitions as parsed by an earlier process."""
+    return new_registry(_pint_cache_folder())
+
+
+def _pint_cache_folder() -> Path:
+    return Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "clearsim" / "pint"
+
+
+def new_registry(cache_folder: Path | None):
+    """A pint registry; parsing pint's unit definitions takes 0.15 s per process (every run, sweep worker and test
+    subprocess), loading them as pint cached them in cache_folder 0.02 s. A folder that cannot be written or a damaged
+    cache only costs that time again."""
+    pint = _import_pint()
+    if cache_folder is not None:
+        try:
+            return pint.UnitRegistry(cache_folder=cache_folder)
+        except Exception:  # noqa: BLE001 — any failure of the cache: parse the definitions as without one
+            pass
+    return pint.UnitRegistry()
 
 
 def _import_pint():
@@ -88,7 +108,7 @@ def parse_quantity(value: Any):
     if not isinstance(value, str):
         raise UnitError(f"expected a number or a 'value unit' string, got {value!r}")
     pint = _import_pint()
-
+    _one_number(value)
     try:
         quantity = registry().Quantity(value.strip())
     except (pint.errors.UndefinedUnitError, pint.errors.DefinitionSyntaxError) as exc:
@@ -99,6 +119,28 @@ def parse_quantity(value: Any):
         raise UnitError(f"cannot read {value!r} as a number with a unit")
     _check_finite(quantity.magnitude, value)
     return quantity
+
+
+LEADING_NUMBER = re.compile(r"\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def _one_number(value: str) -> None:
+    """One number and a unit: pint multiplies whatever it is given ('0.8 0.9' is 0.72, '0.01;0.02' 0.0002,
+    '0.01 mm 2' 0.02 mm), which no one writing a value means. A unit alone ('rpm'), nan and inf are left to pint and
+    to the finiteness check."""
+    lead = LEADING_NUMBER.match(value)
+    if lead is None:
+        return
+    unit = value[lead.end():].strip()
+    if not unit:
+        return
+    try:
+        registry().parse_units(unit)
+    except Exception:  # noqa: BLE001 — a number in the unit part (a factor) or no unit at all
+        if re.search(r"\d", unit):  # a unit without digits that pint does not know: its own message below
+            word = re.match(r"[^\W\d_]\w*", unit)
+            example = f"{value[:lead.end()].strip()} {word.group(0)}" if word else value[:lead.end()].strip()
+            raise UnitError(f"expected one number with a unit, got {value!r}; write one value, e.g. '{example}'") from None
 
 
 def _check_finite(number: float | int, value: Any) -> float:
@@ -151,6 +193,18 @@ def contact_stiffness_to_si(value: Any, exponent: float) -> float:
             f"expected a contact stiffness in N/m^{exponent:g} for exponent n = {exponent:g}, got {value!r}"
         )
     return _check_finite(quantity.to_base_units().magnitude, value)
+
+
+def unit_name(value: str) -> str:
+    """A unit written alone, as a table's `time_unit` (pint's unit syntax, no number: '2 s' would scale the column)."""
+    try:
+        registry().parse_units(value)
+    except Exception:  # pint raises ValueError for a factor, UndefinedUnitError and syntax errors otherwise
+        if any(character.isdigit() for character in value.replace("^", "").replace("**", "")):
+            raise ValueError(f"expected a unit alone, such as 'ms', got {value!r}: a number in it would scale "
+                             "the column") from None
+        raise ValueError(f"unknown unit {value!r}; e.g. 's', 'ms', 'mm', 'kN'") from None
+    return value
 
 
 def _si_validator(kind: str):

@@ -355,14 +355,23 @@ def load_mechanism(path: str | Path, overrides: Sequence[str] = ()) -> LoadedMec
     return load_mechanism_text(read_mechanism_file(path), name=str(path), overrides=overrides, base_dir=path.parent)
 
 
+MAX_FILE_BYTES = 32 * 2**20  # a mechanism file is a few kB; /dev/zero or a wrong file would be read until memory ends
+
+
 def read_mechanism_file(path: Path) -> str:
-    """The text of a mechanism file; InputError when it cannot be read or is not UTF-8 text."""
+    """The text of a mechanism file; InputError when it cannot be read, is not UTF-8 text or is far too large."""
     try:
-        return path.read_text(encoding="utf-8")
+        with path.open("rb") as handle:
+            data = handle.read(MAX_FILE_BYTES + 1)
     except OSError as exc:
         raise InputError([Problem((), f"cannot read the file: {exc.strerror or exc}", "check the path")], path) from None
+    if len(data) > MAX_FILE_BYTES:
+        raise InputError([Problem((), f"cannot read the file: it is larger than {MAX_FILE_BYTES // 2**20} MB, far more "
+                                      "than any mechanism file", "check that this is the right file")], path)
+    try:
+        return data.decode("utf-8").replace("\r\n", "\n").replace("\r", "\n")
     except UnicodeDecodeError:
-        raise InputError([_not_utf8(path.read_bytes())], path) from None
+        raise InputError([_not_utf8(data)], path) from None
 
 
 def _not_utf8(data: bytes) -> Problem:

@@ -81,7 +81,7 @@ def check_references(mechanism: schema.Mechanism, known: dict[str, set] | None =
     invalid: references to them are not reported again.
     """
     names = _Names(mechanism, known)
-    problems = _duplicate_names(mechanism) + _reserved_ground(mechanism)
+    problems = _unusable_names(mechanism) + _duplicate_names(mechanism) + _reserved_ground(mechanism)
     for index, joint in enumerate(mechanism.joints):
         problems += _check_joint(names, joint, ("joints", index), mechanism.defaults)
     for index, driver in enumerate(mechanism.drivers):
@@ -93,6 +93,40 @@ def check_references(mechanism: schema.Mechanism, known: dict[str, set] | None =
         problems += _check_sensor(names, sensor, ("sensors", index))
     problems += _check_output(names, mechanism.output)
     return list(dict.fromkeys(problems))
+
+
+# characters a name cannot hold: where the name goes, each would mean something else
+NAME_SEPARATORS = {
+    "/": "the result file stores each item under its name (`/bodies/<name>/…`), and / would open a group",
+    ".": "`--set` reaches an item by its name (`--set joints.<name>.clearance=…`), and . separates the parts",
+    "=": "`--set` splits path and value at the first =",
+}
+
+
+def name_problem(name: str, singular: str) -> tuple[str, str] | None:
+    """(message, hint) when a name cannot serve as a result-file group and a `--set` path segment, else None."""
+    if not name.strip():
+        return f"a {singular} name must not be empty", f"name the {singular}, e.g. `name: {singular}_1`"
+    if name != name.strip():
+        return (f"the {singular} name {name!r} begins or ends with a space",
+                f"write it without the spaces: `name: {name.strip()}`")
+    for character, reason in NAME_SEPARATORS.items():
+        if character in name:
+            return (f"the {singular} name {name!r} contains {character!r}: {reason}",
+                    f"use letters, digits, _ or - instead, e.g. `name: {name.replace(character, '_')}`")
+    if any(not character.isprintable() for character in name):
+        return f"the {singular} name {name!r} contains a control character", "use letters, digits, _ or - only"
+    return None
+
+
+def _unusable_names(mechanism: schema.Mechanism) -> list[Problem]:
+    problems = []
+    for kind, singular in KINDS.items():
+        for index, item in enumerate(getattr(mechanism, kind)):
+            found = name_problem(item.name, singular)
+            if found is not None:
+                problems.append(Problem((kind, index, "name"), *found))
+    return problems
 
 
 def _duplicate_names(mechanism: schema.Mechanism) -> list[Problem]:

@@ -30,6 +30,7 @@ from clearsim.units import (
     Torque,
     UnitError,
     parse_quantity,
+    unit_name,
 )
 
 RawQuantity = Union[float, str]  # converted where its kind is known (a driver's stroke: m or rad)
@@ -193,6 +194,8 @@ class TableMotion(Strict):
     time_unit: str = Field("s", description="unit of the time column")
     value_unit: str | None = Field(None, description="unit of the value column; default m or rad by the driven coordinate")
 
+    _units_alone = field_validator("time_unit", "value_unit")(lambda value: value if value is None else unit_name(value))
+
 
 Motion = Annotated[
     Union[StrokeMotion, ConstantSpeedMotion, PolynomialMotion, TableMotion], Field(discriminator="law")
@@ -257,6 +260,7 @@ class TabulatedForce(Strict):
     value_unit: str = Field("N", description="unit of the force column")
 
     _unit_direction = field_validator("direction")(_unit_vector)
+    _units_alone = field_validator("time_unit", "value_unit")(unit_name)
 
 
 AppliedForce = Annotated[Union[ConstantForce, SpringDamper, TabulatedForce], Field(discriminator="type")]

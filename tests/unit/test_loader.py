@@ -193,6 +193,14 @@ BAD_FILES = {
                               ["bodies[1] 'rod' → position[0]", "expected a finite number, got '1e400 m'"]),
     "control character": ("  O: [0 m, 0 m]", "  O: [0 m, 0\x07 m]", "\x07",
                           ["invalid YAML: unacceptable character #x0007", "printable text only"]),
+    "slash in a name": ("- name: rod\n", "- name: rod/x\n", "name: rod/x",
+                        ["bodies[1] 'rod/x' → name", "contains '/'", "e.g. `name: rod_x`"]),
+    "dot in a name": ("{name: B,", "{name: B.1,", "{name: B.1,",
+                      ["joints[2] 'B.1' → name", "contains '.'", "--set joints.<name>.clearance"]),
+    "empty name": ("{name: slider_v,", "{name: '',", "{name: '',", ["sensors[1] '' → name", "a sensor name must not be empty"]),
+    "name with a trailing space": ("{name: crank_drive,", "{name: 'crank_drive ',", "crank_drive ",
+                                   ["drivers[0] 'crank_drive ' → name", "begins or ends with a space",
+                                    "`name: crank_drive`"]),
     "recursive alias": ("defaults:\n  bearing_radius: 10 mm", "defaults: &d\n  bearing_radius: *d", "defaults: &d",
                         ["an alias (*name) refers to the block it is in"]),
 }
@@ -328,3 +336,29 @@ def test_override_values_are_read_as_yaml():
     m = load_mechanism_text(SLIDER_CRANK, overrides=["solver.atol=1e-12", "gravity=[0, -9.81 m/s^2]"]).mechanism
     assert m.solver.atol == 1e-12 and m.gravity == pytest.approx((0.0, -9.81))
     assert math.isclose(m.solver.rtol, 1e-7)
+
+
+@pytest.mark.parametrize("unit, fragments", [
+    ("'2 s'", ["forces[0] 'push' → time_unit", "expected a unit alone, such as 'ms', got '2 s'", "would scale"]),
+    ("sekunde", ["forces[0] 'push' → time_unit", "unknown unit 'sekunde'"]),
+])
+def test_a_table_unit_is_a_unit_alone(unit, fragments):
+    """`time_unit: '2 s'` was read as a factor of 2 on the time column (the fuzz of session 7)."""
+    force = ("forces:\n  - {type: tabulated, name: push, body: slider, direction: [1, 0], file: push.csv, "
+             f"time_unit: {unit}}}\n")
+    message = load_error(SLIDER_CRANK + force)
+    for fragment in fragments:
+        assert fragment in message, message
+
+
+def test_table_units_with_prefixes_are_units():
+    from clearsim.model import schema
+    from clearsim.model.loader import parse_yaml
+
+    force = ("forces:\n  - {type: tabulated, name: push, body: slider, direction: [1, 0], file: push.csv, "
+             "time_unit: ms, value_unit: kN}\n")
+    motion = "  - {name: d2, joint: guide, motion: {law: table, file: s.csv, time_unit: min, value_unit: mm}}\n"
+    document, _ = parse_yaml((SLIDER_CRANK + force).replace("sensors:\n", motion + "sensors:\n", 1), "sc.yaml")
+    mechanism = schema.Mechanism.model_validate(document)
+    assert (mechanism.forces[0].time_unit, mechanism.forces[0].value_unit) == ("ms", "kN")
+    assert (mechanism.drivers[1].motion.time_unit, mechanism.drivers[1].motion.value_unit) == ("min", "mm")

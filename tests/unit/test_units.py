@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from clearsim.units import UnitError, contact_stiffness_to_si, to_si
+from clearsim.units import UnitError, contact_stiffness_to_si, parse_quantity, to_si
 
 
 @pytest.mark.parametrize("text, kind, si", [
@@ -75,3 +75,42 @@ def test_a_value_that_is_not_a_finite_number_is_an_error(value, kind):
 def test_a_contact_stiffness_that_is_not_finite_is_an_error():
     with pytest.raises(UnitError, match="expected a finite number"):
         contact_stiffness_to_si("inf N/m^1.5", 1.5)
+
+
+def test_the_unit_registry_loads_from_its_cache_and_converts_the_same(tmp_path):
+    """pint's parsed definitions are cached (0.15 s saved per process); a registry from the cache converts alike."""
+    from clearsim.units import new_registry
+
+    fresh = new_registry(tmp_path / "pint")
+    assert any((tmp_path / "pint").iterdir())  # the cache was written
+    cached = new_registry(tmp_path / "pint")
+    plain = new_registry(None)
+    for text in ("0.01 mm", "5000 rpm", "30 deg", "6.6e10 N/m^1.5", "2 kN*m", "1 bar"):
+        values = [float(r.Quantity(text).to_base_units().magnitude) for r in (fresh, cached, plain)]
+        assert values[0] == values[1] == values[2], text
+
+
+def test_a_cache_folder_that_cannot_be_made_or_is_damaged_only_costs_time(tmp_path):
+    from clearsim.units import new_registry
+
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    assert new_registry(blocker / "pint").Quantity("1 mm").to_base_units().magnitude == 0.001
+    folder = tmp_path / "pint"
+    new_registry(folder)
+    for entry in folder.iterdir():
+        entry.write_bytes(b"damaged")
+    assert new_registry(folder).Quantity("1 mm").to_base_units().magnitude == 0.001
+
+
+@pytest.mark.parametrize("text", ["0.8 0.9", "0.01;0.02", "0.01 mm 2", "0.1 mm 0.2 mm", "3 kg @ 2"])
+def test_a_value_is_one_number_with_a_unit(text):
+    """pint multiplies what it is given: '0.8 0.9' read as 0.72, '0.01;0.02' as 0.0002 — now a message."""
+    with pytest.raises(UnitError, match="expected one number with a unit"):
+        parse_quantity(text)
+
+
+@pytest.mark.parametrize("text, si", [("6.6e10 N/m^1.5", 6.6e10), ("1e-4 kg m^2", 1e-4), ("5 1/s", 5.0),
+                                      ("2 kN*m", 2000.0), ("-0.5 mm", -5e-4)])
+def test_units_with_digits_and_products_still_read(text, si):
+    assert float(parse_quantity(text).to_base_units().magnitude) == pytest.approx(si, rel=1e-15)

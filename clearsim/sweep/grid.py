@@ -21,13 +21,14 @@ from dataclasses import dataclass, field
 
 from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.model.resolve import is_clearance_joint
-from clearsim.units import UnitError, to_si
+from clearsim.units import LEADING_NUMBER, UnitError, to_si
 
 CLEARANCE = "clearance"
 IDEAL = "ideal"
 MAX_NAME = 100
 _UNSAFE = re.compile(r"[^A-Za-z0-9._+-]+")
 _OPEN, _CLOSE = "[{(", "]})"
+_ONE_LENGTH = re.compile(LEADING_NUMBER.pattern + r"\s*[^\W\d_]+\s*$")  # 0.01 mm, 50um, 1e-3 in
 
 
 class SweepOptionError(ClearsimError):
@@ -84,14 +85,24 @@ def clearance_text(value: str) -> str:
         text = f"{value} mm"
     except ValueError:
         text = value
+    one_length = _ONE_LENGTH.match(text)  # pint reads '0.01;0.02' as 0.0002 and '(0.01)' as metres: never a clearance
+    if LEADING_NUMBER.match(text) and not one_length:
+        raise _not_one_clearance(value)
     try:
         metres = to_si(text, "length")
     except UnitError as exc:
         raise SweepOptionError(f"--clearance: {exc}\n  hint: write millimetres as plain numbers "
                                "(--clearance 0.01,0.05) or give a unit (50um)") from None
+    if not one_length:
+        raise _not_one_clearance(value)
     if metres < 0:
         raise SweepOptionError(f"--clearance: a clearance cannot be negative, got {value!r}")
     return text
+
+
+def _not_one_clearance(value: str) -> SweepOptionError:
+    return SweepOptionError(f"--clearance: cannot read {value!r} as one clearance (a number, in mm unless a unit "
+                            "follows it)\n  hint: separate values by commas: --clearance 0.01,0.05 or 10um,50um")
 
 
 def _values(option: str, text: str) -> list[str]:

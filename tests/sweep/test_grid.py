@@ -1,6 +1,7 @@
 """The case list of a sweep: value lists, units, the grid product, ideal references, names, Monte Carlo
 draws, and the messages (exit code 2, nothing written) for options a user can get wrong."""
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +50,34 @@ def test_clearance_values_are_millimetres_unless_a_unit_is_written():
     assert to_si(clearance_text("0"), "length") == 0.0
     with pytest.raises(SweepOptionError, match="expected a length"):
         clearance_text("0.05 s")
+
+
+@pytest.mark.parametrize("value", ["0.01;0.02", "0.01 0.02", "(0.005)", "2*0.001", "0.01 mm 2", "1_0"])
+def test_a_clearance_that_is_not_one_number_is_refused_not_read_as_metres_or_a_product(value):
+    """pint read '0.01;0.02' and '0.01 0.02' as 0.0002 (metres: 0.2 mm), '(0.005)' as 5 mm, '0.01 mm 2' as 0.02 mm:
+    one silent case of the wrong size."""
+    with pytest.raises(SweepOptionError, match=r"--clearance: cannot read .* as one clearance .*\n  hint: separate "
+                                               "values by commas: --clearance 0.01,0.05"):
+        plan(clearance=value, overrides=["solver.t_end=1ms"])
+
+
+@pytest.mark.parametrize("options, message", [
+    (dict(clearance="0.1,100um"), "--clearance: clearance '0.1 mm' and '100um' give the same mechanism"),
+    (dict(clearance="0.01,0.010"), "--clearance: clearance '0.01 mm' and '0.010 mm' give the same mechanism"),
+    (dict(overrides=["joints.slider_pin.contact.restitution=0.8,0.80"]),
+     "--set joints.slider_pin.contact.restitution: joints.slider_pin.contact.restitution '0.8' and '0.80' give the "
+     "same mechanism"),
+])
+def test_two_swept_values_that_are_one_mechanism_are_refused(options, message):
+    """Was: run once, under the first value's name; the second value had no row in the summary and no file."""
+    with pytest.raises(SweepOptionError, match=re.escape(message) + ".*\n  hint: give each value once"):
+        plan(**options)
+
+
+def test_cases_that_are_the_ideal_mechanism_still_merge_into_it():
+    p = plan(clearance="0,0.1", overrides=["joints.slider_pin.contact.restitution=0.8,0.9"])
+    assert [c.name for c in p.cases] == ["ideal", "clearance-0.1_mm__joints.slider_pin.contact.restitution-0.8",
+                                         "clearance-0.1_mm__joints.slider_pin.contact.restitution-0.9"]
 
 
 def test_grid_is_the_product_of_the_axes_after_the_ideal_case():
@@ -146,6 +175,8 @@ def test_a_tolerance_whose_value_does_not_fit_its_path_is_reported_at_the_tolera
 @pytest.mark.parametrize("options, message", [
     (["--clearance", "0.1,abc"], "error: --clearance: unknown unit in 'abc'"),
     (["--clearance", "0.1,0.2s"], "error: --clearance: expected a length (e.g. '0.01 mm'), got '0.2s' [s]"),
+    (["--clearance", "0.1,20mm"],  # was: "in --set joints.slider_pin.clearance=20mm", a --set never written
+     "error: in --clearance 20mm (joints.slider_pin.clearance)  joints[2] 'slider_pin' → clearance\n  clearance 20 mm"),
     (["--set", "joints.slider_pn.clearance=0.1mm,0.2mm"],
      "error: in --set joints.slider_pn.clearance=0.1mm\n  no joint named 'slider_pn'; did you mean 'slider_pin'?"),
     (["--set", "joints.slider_pin.clearence=0.1mm,0.2mm"], "unknown key 'clearence' in joints.slider_pin; did you mean 'clearance'?"),
@@ -156,6 +187,7 @@ def test_a_tolerance_whose_value_does_not_fit_its_path_is_reported_at_the_tolera
     ([], "error: nothing to sweep"),
     (["--sample", "3"], "declares no `tolerances:`"),
     (["--clearance", "0.1", "--workers", "0"], "error: --workers must be at least 1, got 0"),
+    (["--clearance", "0.1", "--workers", "100000"], "error: --workers 100000: this machine gives clearsim "),  # was: run
     (["--clearance", "0.1", "--delay-fraction", "1.5"], "error: --delay-fraction must be between 0 and 1, got 1.5"),
     (["--sample", "3", "--seed", "-1"], "error: --seed must be 0 or more, got -1"),
 ])
@@ -166,6 +198,82 @@ def test_bad_options_exit_2_with_one_clear_message_and_write_nothing(tmp_path, o
     assert message in result.output and "Traceback" not in result.output
     assert result.output.count("no joint named") <= 1  # one report per distinct problem, not one per case
     assert not out.exists()
+
+
+@pytest.mark.parametrize("options, message", [
+    (["--set", "joints.slider_pin.contact.restitution=0.8,0.9", "--set", "joints.slider_pin.contact.restitution=0.7"],
+     "--set joints.slider_pin.contact.restitution=0.7: joints.slider_pin.contact.restitution is also varied by a --set "
+     "list, which would override this value in every case\n  hint: give the path once"),
+    (["--clearance", "0.1,0.2", "--set", "joints.slider_pin.clearance=0.3mm"],
+     "--set joints.slider_pin.clearance: that clearance is already swept by --clearance\n  hint: leave out the --set"),
+    (["--sample", "2", "--set", "joints.slider_pin.clearance=0.3mm"],
+     "joints.slider_pin.clearance is also varied by the file's tolerances[0], which would override this value in "
+     "every case\n  hint: leave out the --set, or that tolerance"),
+])
+def test_a_single_value_that_the_sweep_would_override_is_refused_not_ignored(tmp_path, options, message):
+    """Was: the single --set value was silently overridden in every case (the sweep ran without it)."""
+    out = tmp_path / "sweep"
+    result = runner.invoke(app, ["sweep", str(with_tolerances(tmp_path)), "--set", "solver.t_end=0.1ms", *options,
+                                 "-o", str(out)])
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert "Traceback" not in result.output and not out.exists()
+
+
+def test_a_normal_tolerance_whose_bounds_miss_it_is_refused_not_clipped(tmp_path):
+    """Was: after 1000 draws outside [low, high] the mean was clipped to a bound: every sample the same value, the
+    samples merged into one case, and --sample 3 ran one sample."""
+    config = with_tolerances(tmp_path, "\ntolerances:\n  - {path: joints.slider_pin.contact.restitution, "
+                                       "distribution: normal, mean: 0.8, std: 0.001, low: 0.1, high: 0.2}\n")
+    result = runner.invoke(app, ["sweep", str(config), "--sample", "3", "-o", str(tmp_path / "out")])
+    assert result.exit_code == 2, result.output
+    assert ("--sample: tolerances[0] (joints.slider_pin.contact.restitution): mean 0.8 ± std 0.001 almost never falls "
+            "within [0.1, 0.2]") in result.output and "hint: check the mean, std, low and high" in result.output
+    assert "Traceback" not in result.output and not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("address, message", [
+    ("tcp://localhost:99999", "the port '99999' is not a number from 1 to 65535"),  # was: a 10 s wait (or an AssertionError)
+    ("tcp://:8786", "expected host:port after the scheme"),  # was: a 10 s wait
+    ("http://localhost:8786", "unknown scheme 'http://'"),
+    ("", "expected host:port after the scheme"),  # was: ignored, the sweep ran on the local pool
+])
+def test_a_malformed_scheduler_address_fails_at_once_without_connecting(tmp_path, address, message):
+    import time
+
+    out = tmp_path / "sweep"
+    start = time.monotonic()
+    result = runner.invoke(app, ["sweep", str(SLIDER_CRANK), "--clearance", "0.1", "--set", "solver.t_end=0.1ms",
+                                 "--scheduler", address, "-o", str(out)])
+    assert result.exit_code == 2, result.output
+    assert f"error: --scheduler {address!r}: {message}" in result.output and "e.g. --scheduler tcp://" in result.output
+    assert "Traceback" not in result.output and not out.exists()
+    assert time.monotonic() - start < 5
+
+
+@pytest.mark.parametrize("options, message", [
+    (["--sample", "1000000000"], "--sample 1000000000: a sweep has at most 100000 cases"),
+    (["--clearance", ",".join(f"{k}um" for k in range(1, 401)), "--set", "bodies.crank.mass=" + ",".join(
+        f"{k}kg" for k in range(1, 401))], "the grid has 160000 cases (400 (clearance) × 400 (bodies.crank.mass)); "
+     "a sweep has at most 100000\n  hint: give fewer values"),
+])
+def test_a_sweep_too_large_to_plan_is_refused_at_once(tmp_path, options, message):
+    """Was: every case drawn and loaded before anything ran: minutes to hours with no output (and for 1e9 samples the
+    memory ran out). The alarm turns that wait into a failure of this test."""
+    import signal
+
+    def too_slow(signum, frame):
+        raise TimeoutError("still planning after 20 s")
+
+    previous = signal.signal(signal.SIGALRM, too_slow)
+    signal.alarm(20)
+    try:
+        result = runner.invoke(app, ["sweep", str(with_tolerances(tmp_path)), *options, "-o", str(tmp_path / "out")])
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+    assert result.exit_code == 2, result.output
+    assert message in result.output and "Traceback" not in result.output and not (tmp_path / "out").exists()
 
 
 def test_a_folder_that_is_not_a_sweep_folder_is_refused(tmp_path):

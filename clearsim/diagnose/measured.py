@@ -28,7 +28,9 @@ from clearsim.units import DIMENSIONS, UnitError, to_si
 
 MIN_SAMPLES = 20
 TIME = "time"
-HEADER = re.compile(r"^\s*(?P<name>[^\[]+?)\s*(?:\[(?P<unit>[^\]]*)\])?\s*$")
+HEADER = re.compile(r"^\s*(?P<name>[^\[\(]+?)\s*(?:[\[\(](?P<unit>[^\]\)]*)[\]\)])?\s*$")
+DELIMITERS = (",", ";", "\t")
+GAP_FACTOR = 10.0  # a time step this many times the record's median step is a gap (or a change of time unit)
 
 # SI unit of each sensor type (as written in /sensors/<name>.attrs["unit"]) and the unit's kind
 SENSOR_TYPE_UNITS = {
@@ -74,23 +76,32 @@ def parse_mapping(items: Sequence[str], what: str = "--map") -> dict[str, str]:
 
 def read_measured(path: Path | str, sensor_units: Mapping[str, str] | None = None,
                   mapping: Mapping[str, str] | None = None, units: Mapping[str, str] | None = None,
-                  required: Sequence[str] = ()) -> MeasuredData:
+                  required: Sequence[str] = (), *, first_column_time: bool = False, mappable: bool = True,
+                  min_samples: int = MIN_SAMPLES, sensors_of: str | None = None) -> MeasuredData:
     """Read a CSV or HDF5 record, map its columns to sensors and convert to SI.
 
     sensor_units: the model's sensors (name → SI unit, see `model_sensor_units`); columns are
     checked against them. Without it every column is a sensor and units only need to be known.
     mapping: column → sensor (or → "time"). units: column → unit, for headers without one.
     required: sensors that must be measured (a missing one is an error).
+    first_column_time: without a `time` column the first column is the time (`clearsim plot`).
+    mappable: the hints may offer --map (False where the command has no such option).
+    sensors_of: what the sensors belong to, for the messages (None: the model; "results/run.h5").
     """
     path = Path(path)
     if not path.exists():
         raise MeasuredDataError(f"{path}: no such file; check the path of the measured data")
+    if path.is_dir():
+        raise MeasuredDataError(f"{path} is a folder; give the measured record itself (a CSV or HDF5 file)")
     if path.suffix.lower() in (".h5", ".hdf5", ".hdf"):
         raw = _hdf5_columns(path)
     else:
         raw = _csv_columns(path)
+    mapping = dict(mapping or {})
+    if first_column_time and raw.columns and TIME not in raw.columns and TIME not in mapping.values():
+        mapping[next(iter(raw.columns))] = TIME
     data = _assemble(path, raw, dict(sensor_units) if sensor_units is not None else None,
-                     dict(mapping or {}), dict(units or {}))
+                     mapping, dict(units or {}), mappable, min_samples, sensors_of)
     for sensor in required:
         if sensor not in data.values:
             raise MeasuredDataError(f"{path}: missing column for sensor '{sensor}' (columns: {', '.join(raw.columns)}); "
@@ -100,34 +111,73 @@ def read_measured(path: Path | str, sensor_units: Mapping[str, str] | None = Non
 
 @dataclass
 class _Raw:
-    """Columns as read: name → (values, unit written in the file, where row k is: 'line n' / 'sample n')."""
+    """Columns as read: name → unit written in the file; values parsed when a column is used (a text column
+    that names no sensor is no error); row k is at `row_names[k]` ('file:line' / 'file: sample n')."""
 
-    columns: dict[str, tuple[np.ndarray, str]]
+    units: dict[str, str]
     row_names: list[str]
+    values: dict[str, np.ndarray] = field(default_factory=dict)
+    text: dict[str, tuple[int, list[tuple[int, str]]]] = field(default_factory=dict)  # CSV: column index, (line, cell)
+    path: Path | None = None
+
+    @property
+    def columns(self) -> dict[str, str]:
+        return self.units
+
+    def array(self, column: str) -> np.ndarray:
+        if column not in self.values:
+            _, cells = self.text[column]
+            self.values[column] = np.array([_number(cell, self.path, line, column) for line, cell in cells], dtype=float)
+        return self.values[column]
 
 
-def _csv_rows(path: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
+def _decoded(path: Path) -> str:
     try:
-        with path.open(newline="", encoding="utf-8-sig") as handle:
-            rows = [(n, row) for n, row in enumerate(csv.reader(handle), start=1)
-                    if row and any(c.strip() for c in row) and not row[0].lstrip().startswith("#")]
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MeasuredDataError(f"{path}: cannot read the file ({exc}); save it as UTF-8 CSV") from None
-    if not rows:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise MeasuredDataError(f"{path}: cannot read the file ({exc.strerror or exc}); check that it exists and "
+                                "can be read") from None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise MeasuredDataError(f"{path}:{line}: byte 0x{data[exc.start]:02x} is not UTF-8 text (is this a CSV file?); "
+                                "save the record as UTF-8 CSV (e.g. 'CSV UTF-8' in a spreadsheet)") from None
+
+
+def _delimiter(line: str) -> str:
+    """The separator of a CSV: the one of , ; tab that the header line holds most of (a comma if none)."""
+    counts = {d: line.count(d) for d in DELIMITERS}
+    best = max(DELIMITERS, key=lambda d: counts[d])
+    return best if counts[best] else ","
+
+
+def _csv_rows(path: Path) -> tuple[int, list[str], list[tuple[int, list[str]]], str]:
+    text = _decoded(path)
+    lines = [(n, line) for n, line in enumerate(text.splitlines(), start=1)
+             if line.strip() and not line.lstrip().startswith("#")]
+    if not lines:
         raise MeasuredDataError(f"{path}: the file is empty; expected a header row such as 'time [ms],<sensor> [mm]'")
-    return rows[0][1], rows[1:]
+    delimiter = _delimiter(lines[0][1])
+    reader = csv.reader([line for _, line in lines], delimiter=delimiter)
+    rows = [(n, row) for (n, _), row in zip(lines, reader) if any(c.strip() for c in row)]
+    if not rows:
+        raise MeasuredDataError(f"{path}: the file holds only separators, no header or numbers; expected a header row "
+                                "such as 'time [ms],<sensor> [mm]'")
+    return rows[0][0], rows[0][1], rows[1:], delimiter
 
 
 def _number(text: str, path: Path, line: int, column: str) -> float:
     try:
         return float(text)
     except ValueError:
-        raise MeasuredDataError(f"{path}:{line}: column '{column}': {text.strip()!r} is not a number; "
-                                "write numbers only below the header (comments start with '#')") from None
+        hint = ("write decimals with a point (0.5, not 0,5)" if re.fullmatch(r"\s*[-+]?\d*,\d+\s*", text)
+                else "write numbers only below the header (comments start with '#')")
+        raise MeasuredDataError(f"{path}:{line}: column '{column}': {text.strip()!r} is not a number; {hint}") from None
 
 
 def _csv_columns(path: Path) -> _Raw:
-    header, rows = _csv_rows(path)
+    header_line, header, rows, delimiter = _csv_rows(path)
     parsed = [HEADER.match(cell) for cell in header]
     names = [m["name"] if m else cell.strip() for m, cell in zip(parsed, header)]
     written = [(m["unit"] or "").strip() if m else "" for m in parsed]
@@ -135,10 +185,19 @@ def _csv_columns(path: Path) -> _Raw:
         if len(row) != len(names):
             raise MeasuredDataError(f"{path}:{line}: {len(row)} values for {len(names)} columns "
                                     f"({', '.join(names)}); every row needs one value per column")
-    data = np.array([[_number(v, path, line, names[k]) for k, v in enumerate(row)] for line, row in rows],
-                    dtype=float).reshape(len(rows), len(names))
-    columns = {name: (data[:, k], written[k]) for k, name in enumerate(names)}
-    return _Raw(columns, [f"{path}:{line}" for line, _ in rows])
+    kept = [k for k, name in enumerate(names) if name or any(row[k].strip() for _, row in rows)]
+    for k in kept:  # an unnamed column with values: named by its place
+        if not names[k]:
+            names[k] = f"(column {k + 1})"
+    seen: dict[str, int] = {}
+    for k in kept:
+        if names[k] in seen:
+            raise MeasuredDataError(f"{path}:{header_line}: columns {seen[names[k]] + 1} and {k + 1} are both named "
+                                    f"'{names[k]}'; which one is meant is ambiguous: rename or remove one of them")
+        seen[names[k]] = k
+    raw = _Raw({names[k]: written[k] for k in kept}, [f"{path}:{line}" for line, _ in rows], path=path)
+    raw.text = {names[k]: (k, [(line, row[k]) for line, row in rows]) for k in kept}
+    return raw
 
 
 def _hdf5_columns(path: Path) -> _Raw:
@@ -147,17 +206,35 @@ def _hdf5_columns(path: Path) -> _Raw:
     try:
         handle = h5py.File(path, "r")
     except OSError as exc:
-        raise MeasuredDataError(f"{path}: not a readable HDF5 file ({exc})") from None
-    with handle:
-        group = handle["sensors"] if isinstance(handle.get("sensors"), h5py.Group) else handle
-        columns = {}
-        if isinstance(handle.get(TIME), h5py.Dataset):
-            columns[TIME] = (np.asarray(handle[TIME][()], dtype=float).ravel(), _unit_attr(handle[TIME]))
-        for name, node in group.items():
-            if isinstance(node, h5py.Dataset) and name != TIME and node.ndim == 1:
-                columns[name] = (np.asarray(node[()], dtype=float), _unit_attr(node))
-    length = max((len(v) for v, _ in columns.values()), default=0)
-    return _Raw(columns, [f"{path}: sample {k}" for k in range(length)])
+        raise MeasuredDataError(f"{path}: not a readable HDF5 file ({exc}); give a CSV record or an HDF5 file with a "
+                                "'time' dataset and one 1-D dataset per sensor") from None
+    units, values = {}, {}
+    try:
+        with handle:
+            if "clearsim_version" in handle.attrs and not bool(handle.attrs.get("complete", True)):
+                status = handle.attrs.get("status", "unknown")
+                status = status.decode() if isinstance(status, bytes) else str(status)
+                raise MeasuredDataError(f"{path}: a clearsim result flagged incomplete (complete = false, status: "
+                                        f"{status}); its record stops where the run did: run it to the end "
+                                        "(`clearsim run`) before using it as measured data")
+            group = handle["sensors"] if isinstance(handle.get("sensors"), h5py.Group) else handle
+            nodes = {}
+            if isinstance(handle.get(TIME), h5py.Dataset):
+                nodes[TIME] = handle[TIME]
+            nodes.update({name: node for name, node in group.items()
+                          if isinstance(node, h5py.Dataset) and name != TIME and node.ndim == 1})
+            for name, node in nodes.items():
+                if node.dtype.kind not in "iuf":
+                    if name == TIME:
+                        raise MeasuredDataError(f"{path}: dataset '{node.name}' holds {node.dtype} values, not numbers; "
+                                                "write the time as numbers")
+                    continue  # a text dataset names no sensor
+                values[name] = np.asarray(node[()], dtype=float).ravel()
+                units[name] = _unit_attr(node)
+    except (OSError, KeyError, RuntimeError) as exc:  # a damaged or truncated file fails as it is read
+        raise MeasuredDataError(f"{path}: the HDF5 file is damaged ({exc}); write the record again") from None
+    length = len(values[TIME]) if TIME in values else max((len(v) for v in values.values()), default=0)
+    return _Raw(units, [f"{path}: sample {k}" for k in range(length)], values, path=path)
 
 
 def _unit_attr(node) -> str:
@@ -165,28 +242,56 @@ def _unit_attr(node) -> str:
     return unit.decode() if isinstance(unit, bytes) else str(unit)
 
 
-def _assemble(path: Path, raw: _Raw, sensor_units: dict | None, mapping: dict, units: dict) -> MeasuredData:
+def _how(column: str, mapping: dict) -> str:
+    return f"--map {column}={mapping[column]}" if column in mapping else "by its name"
+
+
+def _assemble(path: Path, raw: _Raw, sensor_units: dict | None, mapping: dict, units: dict, mappable: bool = True,
+              min_samples: int = MIN_SAMPLES, sensors_of: str | None = None) -> MeasuredData:
     _check_mapping(path, raw, sensor_units, mapping, units)
     target = {column: mapping.get(column, column) for column in raw.columns}
     time_columns = [c for c, t in target.items() if t == TIME]
     if not time_columns:
-        raise MeasuredDataError(f"{path}: no time column (columns: {', '.join(raw.columns)}); name it 'time [unit]' "
-                                "or map it: --map <column>=time")
-    time_column = time_columns[0]
+        map_hint = " or map it: --map <column>=time" if mappable else ""
+        raise MeasuredDataError(f"{path}: no time column (columns: {', '.join(raw.columns)}); name it 'time [unit]'"
+                                f"{map_hint}")
     known = sensor_units if sensor_units is not None else {t: "" for t in target.values() if t != TIME}
+    _check_unambiguous(path, target, known, mapping, mappable)
+    time_column = time_columns[0]
     chosen = {c: t for c, t in target.items() if t in known and c != time_column}
     ignored = [c for c, t in target.items() if c != time_column and c not in chosen]
     if not chosen:
-        raise MeasuredDataError(f"{path}: no column names a model sensor{_suggestions(ignored, known)}; "
-                                f"rename the columns or map them: --map <column>=<sensor> (sensors: {', '.join(known)})")
+        fix = "rename the columns or map them: --map <column>=<sensor>" if mappable else "rename the columns"
+        what = "a model sensor" if sensors_of is None else f"a sensor of {sensors_of}"
+        raise MeasuredDataError(f"{path}: no column names {what}{_suggestions(ignored, known)}; "
+                                f"{fix} (sensors: {', '.join(known)})")
     time = _converted(path, raw, time_column, "s", units)
     values = {t: _converted(path, raw, c, known[t], units) for c, t in chosen.items()}
     for column in [time_column, *chosen]:
-        _check_finite(path, raw, column)
-    _check_time(path, raw, time, time_column)
-    written = {TIME: units.get(time_column, raw.columns[time_column][1])}
-    written.update({t: units.get(c, raw.columns[c][1]) for c, t in chosen.items()})
+        _check_finite(path, raw, column, column == time_column)
+    for column in chosen:
+        _check_alive(path, raw, column, units)
+    _check_time(path, raw, time, time_column, min_samples, units)
+    written = {TIME: units.get(time_column, raw.columns[time_column])}
+    written.update({t: units.get(c, raw.columns[c]) for c, t in chosen.items()})
     return MeasuredData(path, time, values, written, {t: c for c, t in chosen.items()}, ignored)
+
+
+def _check_unambiguous(path: Path, target: dict, known: dict, mapping: dict, mappable: bool) -> None:
+    """Two columns for the time or for one sensor: which one is meant cannot be guessed."""
+    by_target: dict[str, list[str]] = {}
+    for column, sensor in target.items():
+        if sensor == TIME or sensor in known:
+            by_target.setdefault(sensor, []).append(column)
+    for sensor, columns in by_target.items():
+        if len(columns) > 1:
+            first, second = columns[:2]
+            fix = (f"remove or rename one of them, or map it to another sensor with --map"
+                   if mappable else "remove or rename one of them")
+            what = "the time" if sensor == TIME else f"sensor '{sensor}'"
+            raise MeasuredDataError(f"{path}: columns '{first}' ({_how(first, mapping)}) and '{second}' "
+                                    f"({_how(second, mapping)}) both give {what}; which one is meant is ambiguous: "
+                                    f"{fix}")
 
 
 def _suggestions(columns: list[str], known: Mapping[str, str]) -> str:
@@ -204,19 +309,20 @@ def _check_mapping(path: Path, raw: _Raw, sensor_units: dict | None, mapping: di
             raise MeasuredDataError(f"{path}: --map {column}={sensor}: the model has no sensor '{sensor}'"
                                     f"{did_you_mean(sensor, sensor_units)} (sensors: {', '.join(sensor_units)})")
     for column, unit in units.items():
-        header_unit = raw.columns[column][1]
+        header_unit = raw.columns[column]
         if header_unit and header_unit != unit:
             raise MeasuredDataError(f"{path}: column '{column}' is in [{header_unit}] by its header but in [{unit}] "
                                     "by the option; give the unit in one place only")
 
 
 def _converted(path: Path, raw: _Raw, column: str, si_unit: str, units: dict) -> np.ndarray:
-    values, written = raw.columns[column]
-    unit = units.get(column, written)
+    unit = units.get(column, raw.columns[column])
+    factor = _factor(path, column, unit, si_unit)
+    values = raw.array(column)
     if len(values) != len(raw.row_names):
         raise MeasuredDataError(f"{path}: column '{column}' has {len(values)} samples, the time has "
                                 f"{len(raw.row_names)}; every sensor needs one value per time")
-    return values * _factor(path, column, unit, si_unit)
+    return values * factor
 
 
 def _factor(path: Path, column: str, unit: str, si_unit: str) -> float:
@@ -246,20 +352,52 @@ def _kind_of(unit: str) -> str | None:
     return None
 
 
-def _check_finite(path: Path, raw: _Raw, column: str) -> None:
-    bad = np.flatnonzero(~np.isfinite(raw.columns[column][0]))
+def _check_finite(path: Path, raw: _Raw, column: str, is_time: bool = False) -> None:
+    values = raw.array(column)
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size and bad.size == values.size and not is_time:
+        raise MeasuredDataError(f"{path}: column '{column}' holds no numbers (all {values.size} values are NaN or "
+                                "empty): a dead channel; remove the column, or record that sensor again")
     if bad.size:
         raise MeasuredDataError(f"{raw.row_names[bad[0]]}: column '{column}' is not a finite number ({bad.size} "
-                                "such value(s)); remove those rows or fill the gap before diagnosing")
+                                "such value(s)); remove those rows or fill the gap before using the record")
 
 
-def _check_time(path: Path, raw: _Raw, time: np.ndarray, column: str) -> None:
-    if len(time) < MIN_SAMPLES:
-        raise MeasuredDataError(f"{path}: only {len(time)} samples; at least {MIN_SAMPLES} are needed "
+def _check_alive(path: Path, raw: _Raw, column: str, units: dict) -> None:
+    """A sensor column that never changes is a dead channel: it carries no motion and no noise to weigh it by."""
+    values = raw.array(column)
+    if len(values) > 1 and np.ptp(values) == 0.0:
+        unit = units.get(column, raw.columns[column])
+        raise MeasuredDataError(f"{path}: column '{column}' is constant ({values[0]:g}{f' {unit}' if unit else ''} "
+                                f"in all {len(values)} samples): a dead channel; remove the column, or record "
+                                "that sensor again")
+
+
+def _check_time(path: Path, raw: _Raw, time: np.ndarray, column: str, min_samples: int = MIN_SAMPLES,
+                units: dict | None = None) -> None:
+    if len(time) == 0:
+        raise MeasuredDataError(f"{path}: no samples below the header; write one row of numbers per sample")
+    if len(time) < min_samples:
+        raise MeasuredDataError(f"{path}: only {len(time)} samples; at least {min_samples} are needed "
                                 "(record longer or sample faster)")
+    written = raw.array(column)
     steps = np.flatnonzero(np.diff(time) <= 0.0)
     if steps.size:
         k = steps[0] + 1
         raise MeasuredDataError(f"{raw.row_names[k]}: time in column '{column}' does not increase "
-                                f"({raw.columns[column][0][k - 1]:g} then {raw.columns[column][0][k]:g}); "
+                                f"({written[k - 1]:g} then {written[k]:g}); "
                                 "sort the rows by time and remove repeated samples")
+    if len(time) < 3:
+        return
+    step = np.diff(time)
+    usual = float(np.median(step))
+    odd = np.flatnonzero((step > GAP_FACTOR * usual) | (step < usual / GAP_FACTOR))
+    if odd.size:
+        k = odd[0] + 1
+        unit = (units or {}).get(column, raw.columns[column])
+        unit = f" {unit}" if unit else " s"
+        raise MeasuredDataError(f"{raw.row_names[k]}: time in column '{column}' goes from {written[k - 1]:g} to "
+                                f"{written[k]:g}{unit}, a step {step[k - 1] / usual:.3g} times the usual one of "
+                                f"{float(np.median(np.diff(written))):.3g}{unit} ({odd.size} such step(s)); samples "
+                                "are missing there or the time changes unit (e.g. s written as ms): fix the time "
+                                "column, or cut the record there")

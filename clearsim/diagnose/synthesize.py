@@ -29,6 +29,7 @@ from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.units import UnitError, to_si
 
 FILTER_ORDER = 4
+MAX_SAMPLES = 10_000_000  # a record of 10 million rows is ~300 MB of CSV: beyond any bench, and a run at that rate
 # SI unit → (unit written in the CSV, SI value of one of it)
 BENCH_UNITS = {"m": ("mm", 1e-3), "m/s": ("m/s", 1.0), "m/s^2": ("m/s^2", 1.0), "rad": ("deg", np.pi / 180.0),
                "rad/s": ("rad/s", 1.0), "rad/s^2": ("rad/s^2", 1.0), "N": ("N", 1.0)}
@@ -100,6 +101,10 @@ def _noise_std(text: str, clean: np.ndarray, si_unit: str, sensor: str) -> float
             fraction = float(text[:-1]) / 100.0
         except ValueError:
             raise SynthesisError(f"--noise {text!r}: expected a percentage such as 1% or a value with a unit") from None
+        if not np.isfinite(fraction):
+            raise SynthesisError(f"--noise {text!r}: expected a finite percentage such as 1%")
+        if fraction < 0.0:
+            raise SynthesisError(f"--noise {text!r}: the noise level cannot be negative")
         std = fraction * float(np.ptp(clean))
     else:
         kind = UNIT_KINDS.get(si_unit)
@@ -115,14 +120,32 @@ def _noise_std(text: str, clean: np.ndarray, si_unit: str, sensor: str) -> float
     return std
 
 
-def _run_model(request: SynthesisRequest, rate: float):
+def _checked_record(request: SynthesisRequest, loaded, rate: float, offset: float) -> list[str]:
+    """The sensors to record, once everything that can be checked before the run is: the record's length
+    (t_end + τ at the rate) and each sensor's --noise."""
+    sensors = _chosen_sensors(loaded.mechanism, request.sensors)
+    t_end = loaded.mechanism.solver.t_end
+    if t_end + offset <= 0.0:
+        raise SynthesisError(f"--trigger-offset {request.trigger_offset!r}: a record that starts "
+                             f"{-offset * 1e3:g} ms after the trigger misses the whole run (solver.t_end = "
+                             f"{t_end * 1e3:g} ms); give an offset above {-t_end * 1e3:g} ms")
+    count = (t_end + offset) * rate
+    if count > MAX_SAMPLES:
+        raise SynthesisError(f"--rate {request.rate!r} with --trigger-offset {request.trigger_offset!r}: the record "
+                             f"would hold {count:.3g} samples over {(t_end + offset) * 1e3:g} ms, more than "
+                             f"{MAX_SAMPLES:.0e}; lower --rate or the trigger offset (a bench records at 1–100 kHz)")
+    units = {s.name: SENSOR_TYPE_UNITS[s.type] for s in loaded.mechanism.sensors}
+    for name in sensors:  # the syntax, sign and unit of --noise; a % of the range is applied after the run
+        _noise_std(request.noise, np.zeros(2), units[name], name)
+    return sensors
+
+
+def _run_model(request: SynthesisRequest, rate: float, loaded, sensors: list[str]):
     """(mechanism, /time, {sensor: values}) of a run written at no less than `rate`."""
     from clearsim.io.hdf5 import read_result
     from clearsim.model.loader import load_mechanism
     from clearsim.runner import prepare, run_to_file
 
-    loaded = load_mechanism(request.config, request.overrides)
-    sensors = _chosen_sensors(loaded.mechanism, request.sensors)
     if loaded.mechanism.solver.output_rate < rate:
         loaded = load_mechanism(request.config, [*request.overrides, f"solver.output_rate={rate!r} Hz"])
     with tempfile.TemporaryDirectory(prefix="clearsim-synthesize-") as folder:
@@ -151,11 +174,17 @@ def _lowpass(values: np.ndarray, cutoff: float, rate: float) -> np.ndarray:
 
 def synthesize(request: SynthesisRequest) -> Synthesized:
     """Run the model and write a measured-like CSV (see the module docstring)."""
+    from clearsim.model.loader import load_mechanism
+
     output = Path(request.output)
+    if output.is_dir():
+        raise SynthesisError(f"-o {output}: is a folder; give the file to write, e.g. -o {output / 'bench.csv'}")
     if output.exists() and not request.force:
         raise SynthesisError(f"{output} exists; choose another -o or pass --force to overwrite it")
     rate, cutoff, offset = _settings(request)
-    mechanism, model_time, signals = _run_model(request, rate)
+    loaded = load_mechanism(request.config, request.overrides)
+    sensors = _checked_record(request, loaded, rate, offset)
+    mechanism, model_time, signals = _run_model(request, rate, loaded, sensors)
     time = _record_times(float(model_time[-1]), rate, offset)
     if len(time) < 20:
         raise SynthesisError(f"only {len(time)} samples at {rate:g} Hz over the run and trigger offset; "

@@ -33,6 +33,8 @@ from clearsim.units import UnitError, to_si
 RESULTS = Path("results")
 FIT_TOP = 3
 MIN_SAMPLES = 200  # the noise spectrum and the comparison filter need a few hundred samples
+MIN_CYCLES = 2  # --lowpass: cycles of the cut-off over the record (n_eff ≈ 2·f_c·T)
+MIN_COVERAGE = 0.1  # of the simulated window the record must cover, and of the record that must lie in the window
 
 
 class DiagnoseError(ClearsimError):
@@ -118,6 +120,9 @@ def chosen_kinds(text: str | None) -> list[str]:
     if not text:
         return list(KINDS)
     kinds = [k.strip() for k in text.split(",") if k.strip()]
+    if not kinds:
+        raise DiagnoseError(f"--candidates {text!r}: names no kind of effect; give some of {', '.join(KINDS)}, "
+                            "or leave the option out for all")
     for kind in kinds:
         if kind not in KINDS:
             raise DiagnoseError(f"--candidates: unknown kind '{kind}'{did_you_mean(kind, KINDS)} "
@@ -140,11 +145,46 @@ def _cutoff(text: str | None) -> float | None:
 def _executor(request: DiagnoseRequest):
     from clearsim.sweep import DaskCluster, LocalPool
 
-    if request.scheduler:
+    if request.scheduler is not None:  # "" is a malformed address (DaskCluster says so), not "no cluster"
         executor = DaskCluster(request.scheduler, request.workers)
         executor.connect()
         return executor
     return LocalPool(request.workers).open()
+
+
+def _ms(seconds: float) -> str:
+    return f"{seconds * 1e3:.4g} ms"
+
+
+def check_window(measured: MeasuredData, t_end: float) -> None:
+    """The record must cover the simulated window 0…t_end (the model is held at its first and last values
+    outside it): with at least MIN_SAMPLES samples inside it, over at least MIN_COVERAGE of it, and with at
+    least MIN_COVERAGE of the record inside it. A time column off by a unit fails one of these."""
+    time, path = measured.time, measured.path
+    where = f"{path}: column '{measured.columns.get('time', 'time')}'"
+    spans = f"the record spans {_ms(time[0])} to {_ms(time[-1])}, the model 0 to {_ms(t_end)} (solver.t_end)"
+    unit = measured.units.get("time") or "s"
+    ratio = (time[-1] - time[0]) / t_end
+    hint = (f"; is the time in [{unit}]? a time unit off by 1000 (s written as ms or ms as s) looks like this"
+            if ratio > 100 or ratio < 0.01 else "")
+    inside = np.count_nonzero((time >= 0.0) & (time <= t_end))
+    if time[-1] < 0.0 or time[0] > t_end:
+        raise DiagnoseError(f"{where}: {spans}: the record does not cover the simulated window{hint}; the time must "
+                            "be 0 at the trigger, where the model starts (shift the time column)")
+    if inside < MIN_SAMPLES:
+        raise DiagnoseError(f"{where}: {spans}: only {inside} samples lie in the simulated window, too few to compare "
+                            f"(at least {MIN_SAMPLES}){hint}; record the motion the model simulates, at a few kHz "
+                            "or more, or set solver.t_end to the recorded span")
+    covered = (min(time[-1], t_end) - max(time[0], 0.0)) / t_end
+    if covered < MIN_COVERAGE:
+        raise DiagnoseError(f"{where}: {spans}: the record covers {covered:.1%} of the simulated window, too short to "
+                            f"compare (at least {MIN_COVERAGE:.0%}){hint}; record the whole motion, or lower "
+                            f"solver.t_end (--set solver.t_end=...) to the recorded span")
+    share = inside / len(time)
+    if share < MIN_COVERAGE:
+        raise DiagnoseError(f"{where}: {spans}: only {share:.1%} of the record lies in the simulated window, the "
+                            f"rest would be compared with a model at rest{hint}; raise solver.t_end "
+                            "(--set solver.t_end=...) or cut the record to the motion")
 
 
 def default_folder(request: DiagnoseRequest) -> Path:
@@ -156,6 +196,12 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
     started = clock.perf_counter()
     if request.max_effects < 1:
         raise DiagnoseError(f"--max-effects must be at least 1, got {request.max_effects}")
+    if request.fit_top < 1:
+        raise DiagnoseError(f"--fit-top must be at least 1 (the candidates fitted in full per iteration), "
+                            f"got {request.fit_top}")
+    if request.out is not None and Path(request.out).exists() and not Path(request.out).is_dir():
+        raise DiagnoseError(f"-o {request.out}: is a file, not a folder; give the folder for the report "
+                            "(new, or one of an earlier diagnosis)")
     kinds = chosen_kinds(request.candidates)
     cutoff = _cutoff(request.lowpass)
     loaded = load_mechanism(request.config, request.overrides)
@@ -164,6 +210,12 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
     if len(measured.time) < MIN_SAMPLES:
         raise DiagnoseError(f"{request.measured}: only {len(measured.time)} samples; diagnosing needs at least "
                             f"{MIN_SAMPLES} (record the whole motion, at a few kHz or more)")
+    check_window(measured, loaded.mechanism.solver.t_end)
+    span = float(measured.time[-1] - measured.time[0])
+    if cutoff is not None and cutoff * span < MIN_CYCLES:
+        raise DiagnoseError(f"--lowpass {request.lowpass!r}: below {MIN_CYCLES} cycles over the record "
+                            f"({span * 1e3:.4g} ms), the comparison would keep no independent samples; give at "
+                            f"least {MIN_CYCLES / span:.3g} Hz, or leave the option out to estimate it from the record")
     record = prepare_record(measured.time, measured.values, cutoff)
     units = model_sensor_units(loaded.mechanism)
     say(_record_line(record))

@@ -90,7 +90,7 @@ def test_an_existing_report_is_kept(hidden_clearance, tmp_path):
     assert (report / "diagnosis.1.json").read_text() == before  # the earlier one, renamed
 
 
-@pytest.mark.parametrize("problem, content, message", [
+BAD_RECORDS = [
     ("no sensor column", "time [ms],slider_displacment [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(300)),
      "did you mean 'slider_displacement'"),
     ("no time column", "t [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(300)),
@@ -105,13 +105,29 @@ def test_an_existing_report_is_kept(hidden_clearance, tmp_path):
      "at least"),
     ("too short to diagnose", "time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(50)),
      "diagnosing needs at least"),
-])
+    ("after the simulated window", "time [ms],slider_displacement [mm]\n" + "".join(f"{5000 + k * 0.02},{k % 17}\n" for k in range(1300)),
+     "column 'time': the record spans 5000 ms to 5026 ms, the model 0 to 24 ms (solver.t_end): the record does not cover "
+     "the simulated window; the time must be 0 at the trigger"),
+    ("time in ms written as s", "time [s],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k % 17}\n" for k in range(1300)),
+     "only 2 samples lie in the simulated window, too few to compare (at least 200); is the time in [s]? a time unit "
+     "off by 1000"),
+    ("too short a stretch", "time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.001},{k % 17}\n" for k in range(1000)),
+     "the record covers 4.2% of the simulated window, too short to compare (at least 10%); record the whole motion, "
+     "or lower solver.t_end"),
+    ("mostly after the motion", "time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k % 17}\n" for k in range(13000)),
+     "only 9.2% of the record lies in the simulated window, the rest would be compared with a model at rest; "
+     "raise solver.t_end"),
+]
+
+
+@pytest.mark.parametrize("problem, content, message", BAD_RECORDS, ids=[case[0] for case in BAD_RECORDS])
 def test_bad_measured_data_is_one_message_and_exit_code_2(tmp_path, problem, content, message):
     record = tmp_path / "bench.csv"
     record.write_text(content)
     result = invoke("diagnose", SLIDER_CRANK, *IDEAL, "--measured", record, "-o", tmp_path / "report")
     assert result.exit_code == 2, (problem, result.output)
-    assert "bench.csv" in result.output and message in result.output and "Traceback" not in result.output
+    output = " ".join(result.output.split())
+    assert "bench.csv" in output and message in output and "Traceback" not in output
     assert not (tmp_path / "report" / "diagnosis.json").exists()
 
 
@@ -119,13 +135,22 @@ def test_bad_measured_data_is_one_message_and_exit_code_2(tmp_path, problem, con
     (["--candidates", "clearence"], "did you mean 'clearance'"),
     (["--max-effects", "0"], "--max-effects"),
     (["--lowpass", "2 kg"], "--lowpass"),
+    (["--fit-top", "0"], "--fit-top must be at least 1 (the candidates fitted in full per iteration), got 0"),
+    (["--candidates", ",,"], "--candidates ',,': names no kind of effect; give some of clearance,"),
+    (["--lowpass", "10Hz"], "--lowpass '10Hz': below 2 cycles over the record (5.98 ms), the comparison would keep no "
+     "independent samples; give at least 334 Hz"),
+    (["--workers", "0"], "--workers must be at least 1, got 0"),
+    (["-o", "{tmp}/notes.txt"], "notes.txt: is a file, not a folder; give the folder for the report"),
 ])
 def test_bad_options_are_one_message_and_exit_code_2(tmp_path, options, message):
     record = tmp_path / "bench.csv"
     record.write_text("time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(300)))
+    (tmp_path / "notes.txt").write_text("not a folder")
+    options = [option.format(tmp=tmp_path) for option in options]
     result = invoke("diagnose", SLIDER_CRANK, *IDEAL, "--measured", record, *options)
     assert result.exit_code == 2
-    assert message in result.output
+    assert message in " ".join(result.output.split()) and "Traceback" not in result.output
+    assert (tmp_path / "notes.txt").read_text() == "not a folder"
 
 
 def test_candidate_documents_are_valid_mechanisms():

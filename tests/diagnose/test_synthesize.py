@@ -105,9 +105,48 @@ def test_refuses_to_overwrite_unless_forced(tmp_path):
     (["--noise", "lots%"], "--noise 'lots%': expected a percentage such as 1% or a value with a unit"),
     (["--set", "solver.t_end=0.5ms"], "only 8 samples at 15000 Hz over the run and trigger offset"),
     (["--seed", "-1"], "--seed -1: the seed must be 0 or more"),
-])
+    (["--noise", "nan%"], "--noise 'nan%': expected a finite percentage such as 1%"),
+    (["--noise", "inf%"], "--noise 'inf%': expected a finite percentage such as 1%"),
+    (["--noise", "-1%"], "--noise '-1%': the noise level cannot be negative"),
+    (["--noise", "-0.01mm"], "--noise '-0.01mm': the noise level cannot be negative"),
+    (["--noise", "nan mm"], "--noise 'nan mm' for sensor 'slider_displacement' [m]: expected a finite number"),
+    (["--rate", "0Hz"], "--rate '0Hz': the sampling rate must be positive"),
+    (["--rate", "nan Hz"], "--rate 'nan Hz': expected a finite number"),
+    (["--rate", "1e12Hz"], "--rate '1e12Hz' with --trigger-offset '0ms': the record would hold 6e+09 samples over 6 ms, "
+     "more than 1e+07; lower --rate or the trigger offset"),
+    (["--trigger-offset", "1e6s"], "--rate '15kHz' with --trigger-offset '1e6s': the record would hold 1.5e+10 samples"),
+    (["--trigger-offset", "-10ms"], "--trigger-offset '-10ms': a record that starts 10 ms after the trigger misses the "
+     "whole run (solver.t_end = 6 ms); give an offset above -6 ms"),
+    (["--trigger-offset", "nan ms"], "--trigger-offset 'nan ms': expected a finite number"),
+    (["--lowpass", "nan Hz"], "--lowpass 'nan Hz': expected a finite number"),
+    (["--sensors", ",,"], "--sensors ',,': names no sensor"),
+    (["--set", "solver.t_end=nan ms"], "in --set solver.t_end=nan ms solver → t_end expected a finite number"),
+], ids=lambda value: " ".join(value) if isinstance(value, list) else "")
 def test_bad_options_exit_2_with_the_message(tmp_path, options, message):
     result = invoke("synthesize", SLIDER_CRANK, *SHORT, "-o", tmp_path / "bench.csv", *options)
     assert result.exit_code == 2
     assert message in " ".join(result.output.split())
+    assert "Traceback" not in result.output
     assert not (tmp_path / "bench.csv").exists()
+
+
+@pytest.mark.parametrize("options, message", [
+    (["--noise", "-1%"], "--noise '-1%': the noise level cannot be negative"),
+    (["--rate", "1e12Hz"], "the record would hold"),
+], ids=["negative noise", "a rate of a TeraHertz"])
+def test_bad_options_are_refused_before_the_model_runs(tmp_path, monkeypatch, options, message):
+    import clearsim.runner
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the model ran")
+
+    monkeypatch.setattr(clearsim.runner, "run_to_file", no_run)
+    result = invoke("synthesize", SLIDER_CRANK, *SHORT, "-o", tmp_path / "bench.csv", *options)
+    assert result.exit_code == 2 and message in " ".join(result.output.split()), result.output
+
+
+def test_an_output_that_is_a_folder_is_named_even_with_force(tmp_path):
+    result = invoke("synthesize", SLIDER_CRANK, *SHORT, "-o", tmp_path, "--force")
+    assert result.exit_code == 2
+    assert f"-o {tmp_path}: is a folder; give the file to write, e.g. -o {tmp_path / 'bench.csv'}" in \
+        " ".join(result.output.split())

@@ -40,6 +40,7 @@ class RunData:
     label: str = ""
     index: int = 0  # place among overlaid runs: its colour in every figure
     window: slice = field(default_factory=lambda: slice(None))
+    notes: list = field(default_factory=list)  # what the user should know about this file (cut short, ...)
 
     @property
     def name(self) -> str:
@@ -85,6 +86,9 @@ def _units(path: Path) -> dict:
     return {key: value.decode() if isinstance(value, bytes) else str(value) for key, value in units.items()}
 
 
+DAMAGED_HINT = "run it again (`clearsim run`), or plot the other files"
+
+
 def _read(path: Path) -> tuple[dict, dict]:
     if not path.exists():
         raise PlotInputError(f"no such file: {path}")
@@ -93,10 +97,57 @@ def _read(path: Path) -> tuple[dict, dict]:
     if not h5py.is_hdf5(path):
         raise PlotInputError(f"{path} is not an HDF5 file (clearsim results are written by `clearsim run`)")
     try:
-        data = read_result(path)
+        return read_result(path), _units(path)
     except NotAResultFile as exc:
-        raise PlotInputError(str(exc)) from None
-    return data, _units(path)
+        hint = (f"it is cut short or damaged: {DAMAGED_HINT}" if "not a readable" in str(exc)
+                else "give files written by `clearsim run` or `clearsim sweep`")
+        raise PlotInputError(f"{exc}; {hint}") from None
+    except (OSError, RuntimeError, KeyError, ValueError) as exc:  # libhdf5 fails on a damaged file as it reads it
+        raise PlotInputError(f"{path}: the HDF5 file is damaged and cannot be read ({exc}); {DAMAGED_HINT}") from None
+
+
+def _per_sample(key: str) -> bool:
+    """Datasets with one row per time sample (the tables under joints/<J>/episodes/ have their own length)."""
+    parts = key.split("/")
+    return parts[0] in ("bodies", "constraints", "drivers", "energy", "sensors") or (parts[0] == "joints" and len(parts) == 3)
+
+
+def _check_samples(path: Path, attrs: dict, data: dict) -> list[str]:
+    """/time is numbers, one per row of every per-sample dataset. A file flagged incomplete (a run cut off between
+    two writes) is cut to the rows every dataset has, with a note; a complete file that disagrees is damaged."""
+    time = data["time"]
+    if not isinstance(time, np.ndarray) or time.ndim != 1 or time.dtype.kind not in "iuf":
+        shape = getattr(time, "shape", ())
+        raise PlotInputError(f"{path}: dataset /time is not a column of numbers (shape {shape}, "
+                             f"type {getattr(time, 'dtype', type(time).__name__)}); the file was not written by clearsim "
+                             f"or is damaged: {DAMAGED_HINT}")
+    if len(time) < 2:
+        raise PlotInputError(f"{path}: dataset /time holds {len(time)} sample(s), too few to plot "
+                             f"(status: {attrs.get('status', 'unknown')}); the run stopped before it wrote its "
+                             "second sample: run it again")
+    lengths = {}
+    for key, values in data.items():
+        if key == "time" or not _per_sample(key):
+            continue
+        if not isinstance(values, np.ndarray) or values.ndim == 0 or values.dtype.kind not in "iufb":
+            raise PlotInputError(f"{path}: dataset /{key} is not an array of numbers "
+                                 f"(type {getattr(values, 'dtype', type(values).__name__)}); the file is damaged: "
+                                 f"{DAMAGED_HINT}")
+        lengths[key] = len(values)
+    shortest = min([len(time), *lengths.values()])
+    if shortest == len(time) and all(n == len(time) for n in lengths.values()):
+        return []
+    key = next((k for k, n in lengths.items() if n != len(time)), "time")
+    if bool(attrs.get("complete", False)):
+        raise PlotInputError(f"{path}: dataset /{key} has {lengths.get(key, len(time))} samples, /time has "
+                             f"{len(time)}; the file says it is complete but is damaged: {DAMAGED_HINT}")
+    if shortest < 2:
+        raise PlotInputError(f"{path}: dataset /{key} holds {lengths.get(key, len(time))} sample(s), too few to plot; "
+                             f"the run was cut off ({attrs.get('status', 'unknown')}): run it again")
+    for k in ["time", *lengths]:
+        data[k] = data[k][:shortest]
+    return [f"{path}: the datasets of this incomplete file end at different samples (/{key} has "
+            f"{lengths.get(key, len(time))}, /time {len(time)}): plotted the first {shortest}"]
 
 
 def _mechanism(config_yaml: str, path: Path):
@@ -141,8 +192,12 @@ def load_run(path: Path | str) -> RunData:
     attrs = data.pop("attrs")
     if "time" not in data:
         raise PlotInputError(f"{path}: no dataset /time; the run wrote no samples")
+    notes = _check_samples(path, attrs, data)
     mechanism = _mechanism(str(attrs.get("config_yaml", "")), path)
-    run = RunData(path, attrs, data, units, mechanism, _output(mechanism, data), {})
+    if mechanism is None:
+        notes.append(f"{path}: its stored mechanism (config_yaml) cannot be read: no output sensors or clearance "
+                     "circles are known, all sensors are drawn")
+    run = RunData(path, attrs, data, units, mechanism, _output(mechanism, data), {}, notes=notes)
     run.clearances = _clearances(mechanism, run.clearance_joints)
     return run
 
@@ -163,6 +218,9 @@ def parse_time_window(text: str | None) -> tuple[float, float] | None:
             bounds.append(default if not part else float(part) * 1e-3 if _is_number(part) else to_si(part, "time"))
         except UnitError as exc:
             raise PlotInputError(f"--time-window {text!r}: {exc}") from None
+    if any(np.isnan(bounds)) or any(np.isinf(b) for b, part in zip(bounds, parts) if part.strip()):
+        raise PlotInputError(f"--time-window {text!r}: expected finite times, e.g. 10:20 (ms) or 10ms:20ms; "
+                             "leave an end empty for the start or end of the run")
     if bounds[0] >= bounds[1]:
         raise PlotInputError(f"--time-window {text!r}: the start must come before the end")
     return bounds[0], bounds[1]

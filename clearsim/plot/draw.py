@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.patches import Rectangle
 
+from clearsim.io.files import same_file
 from clearsim.plot.drawing import draw_mechanism, drawing_size, label_items, legend_handles
 from clearsim.plot.geometry import Geometry, extent, mechanism_geometry, to_global
 from clearsim.plot.labelling import place_labels
@@ -115,6 +116,21 @@ def draw_figure(mechanism, body_names: list[str], q0: np.ndarray, subtitle: str 
     return figure
 
 
+def _check_figure_path(out: Path, config: Path, fmt: str) -> None:
+    """A drawing replaces an earlier figure, never a folder, the mechanism file or another file that is no figure."""
+    from clearsim.plot.data import PlotInputError
+
+    hint = f"hint: give a figure file such as -o {out.with_suffix('.' + fmt).name if out.name else 'drawing.' + fmt}"
+    if out.is_dir():
+        raise PlotInputError(f"-o {out}: is a folder, not a figure file\n  hint: name the file in it, "
+                             f"e.g. -o {out / ('drawing.' + fmt)}")
+    if same_file(out, config):
+        raise PlotInputError(f"-o {out}: that is the mechanism file being drawn; the figure would overwrite it\n  {hint}")
+    if out.exists() and out.suffix.lstrip(".").lower() not in FORMATS:
+        raise PlotInputError(f"-o {out}: an existing file that is not a figure ({', '.join(FORMATS)}); "
+                             f"the drawing would overwrite it\n  {hint}")
+
+
 def draw_config(config: Path, overrides=(), out: Path | None = None, fmt: str | None = None,
                 interactive: bool = False) -> tuple[Path, list[str]]:
     """Load, assemble and draw a mechanism file; returns the written figure and notes for the user.
@@ -129,6 +145,8 @@ def draw_config(config: Path, overrides=(), out: Path | None = None, fmt: str | 
     fmt = fmt or (suffix if suffix in FORMATS else "png")
     if fmt not in FORMATS:
         raise PlotInputError(f"--format {fmt!r}: expected one of {', '.join(FORMATS)}")
+    if out is not None:
+        _check_figure_path(Path(out), Path(config), fmt)
     loaded = load_mechanism(config, overrides)
     system = prepare(loaded)
     clearance = ", ".join(system.clearance_joints) or "none"

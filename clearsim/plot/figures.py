@@ -65,9 +65,20 @@ def _inputs(paths: list) -> _Inputs:
     return _Inputs(paths, paths[0].stem if len(paths) == 1 else "compare", None)
 
 
-def _load(inputs: _Inputs, request: PlotRequest) -> list[RunData]:
+def _load(inputs: _Inputs, request: PlotRequest, notes: list) -> list[RunData]:
+    """The runs; in a sweep folder a case file that cannot be plotted is skipped with a note (the others are
+    plotted), while a file named on the command line must be plottable."""
     window = parse_time_window(request.time_window)
-    runs = [load_run(path) for path in inputs.files]
+    runs = []
+    for path in inputs.files:
+        try:
+            runs.append(load_run(path))
+        except PlotInputError as exc:
+            if inputs.folder is None:
+                raise
+            notes.append(f"skipped case {path.stem}: {exc} (a re-run of the sweep runs that case again)")
+    if not runs:
+        raise PlotInputError(f"{inputs.folder}: no case file can be plotted:\n  " + "\n  ".join(notes))
     labels = run_labels(runs) if len(runs) > 1 else [""] * len(runs)
     for index, (run, label) in enumerate(zip(runs, labels)):
         apply_window(run, window)
@@ -108,15 +119,22 @@ def build_figures(runs: list[RunData], request: PlotRequest, folder: Path | None
         figures["spectrum"] = history.spectrum_figure(runs, spectrum, show)
     figures["energy"] = history.energy_figure(runs, show)
     if request.measured is not None:
-        measurement = measured_plots.within(measured_plots.read_measurement(request.measured),
-                                            parse_time_window(request.time_window))
+        record = measured_plots.read_measurement(request.measured, measured_plots.run_sensor_units(runs[0]),
+                                                 str(runs[0].path))
+        measurement = measured_plots.within(record, parse_time_window(request.time_window))
         names = measured_plots.matched_sensors(measurement, runs, chosen)
         figures["measured"] = measured_plots.measured_figure(runs, measurement, names, show)
-    summary = sweep.summary_of(folder) if folder is not None else None
+    summary = sweep.summary_of(folder, notes) if folder is not None else None
     if summary is not None:
         figures["merit"] = sweep.merit_figure(summary, f"sweep folder {folder.name}", show)
-    notes += [f"{run.path} is incomplete ({run.attrs.get('status', 'unknown')}): plotted up to "
-              f"{run.time[-1] * 1e3:.3f} ms" for run in runs if not run.complete]
+    for run in runs:
+        notes += run.notes
+        if "complete" not in run.attrs:
+            notes.append(f"{run.path} does not say whether its run completed (no 'complete' attribute): plotted up "
+                         f"to {run.time[-1] * 1e3:.3f} ms")
+        elif not run.complete:
+            notes.append(f"{run.path} is incomplete ({run.attrs.get('status', 'unknown')}): plotted up to "
+                         f"{run.time[-1] * 1e3:.3f} ms")
     return figures, notes
 
 
@@ -140,12 +158,16 @@ def plot_results(request: PlotRequest) -> PlotReport:
     """Read the inputs, build every figure, then write them (and the animations); paths and notes."""
     if request.fmt not in FORMATS:
         raise PlotInputError(f"--format {request.fmt!r}: expected one of {', '.join(FORMATS)}")
+    if request.out is not None and Path(request.out).exists() and not Path(request.out).is_dir():
+        raise PlotInputError(f"--out {request.out}: is a file, not a folder; give the folder for the figures")
     inputs = _inputs(request.inputs)
-    runs = _load(inputs, request)
+    skipped: list = []
+    runs = _load(inputs, request, skipped)
     exaggerate = parse_exaggerate(request.exaggerate)
     for run in runs if request.animate else []:
         check_animation(run)
     figures, notes = build_figures(runs, request, inputs.folder)
+    notes = skipped + notes
     folder = _output_folder(request, inputs)
     written = _save(figures, folder, inputs.stem, request.fmt)
     if request.animate:

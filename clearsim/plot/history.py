@@ -109,7 +109,8 @@ def plot_energies(run: RunData, ax=None):
         ax.plot(TIME(run.time), values, label=label)
     ax.set_ylabel("energy (J)")
     ax.set_xlabel(TIME.label("time"))
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    if ax.lines:  # a file without energies: an empty panel, not a matplotlib warning
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     return ax
 
 

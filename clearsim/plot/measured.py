@@ -1,93 +1,57 @@
 """Simulation over measurement: a bench record (CSV) on the same axes as the runs, residual below.
 
-The CSV has a header row; each column is named after a sensor of the result file, with its
-unit in brackets (`sealing_rod_displacement [mm]`); the time column is `time` (or the first
-column), `time [ms]` by default in seconds. Lines starting with `#` are comments. A column
-without a unit is in the sensor's SI unit. The residual is simulation − measurement at the
-measured times (the simulation interpolated linearly), where both exist.
+The record is read by the one parser of measured data, `clearsim.diagnose.measured.read_measured`
+(docs/diagnose.md, "Measured data"), with every check of `clearsim diagnose`: the header row names
+each column after a sensor of the result file, with its unit in brackets or parentheses
+(`sealing_rod_displacement [mm]`); the time column is `time` (or the first column). Lines starting
+with `#` are comments; the separator may be `,`, `;` or a tab. A column without a unit is in the
+sensor's SI unit. The residual is simulation − measurement at the measured times (the simulation
+interpolated linearly), where both exist.
 """
 
 from __future__ import annotations
 
-import csv
-import re
-from dataclasses import dataclass
+from dataclasses import replace
 from pathlib import Path
+from typing import Mapping
 
 import numpy as np
 
+from clearsim.diagnose.measured import MeasuredData, read_measured
 from clearsim.plot.data import PlotInputError, RunData
 from clearsim.plot.history import pretty
 from clearsim.plot.scales import TIME, scale_for
 from clearsim.plot.style import axes_or_new, new_figure, run_style, set_title, title_of
 
-HEADER = re.compile(r"^\s*(?P<name>[^\[\(]+?)\s*(?:[\[\(](?P<unit>[^\]\)]*)[\]\)])?\s*$")
+MIN_SAMPLES = 2  # a plot needs a line, not a noise estimate
+Measurement = MeasuredData
 
 
-@dataclass
-class Measurement:
-    path: Path
-    time: np.ndarray  # s
-    columns: dict  # name → (values as written, unit as written or "")
+def read_measurement(path: Path | str, sensor_units: Mapping[str, str] | None = None,
+                     sensors_of: str | None = None) -> MeasuredData:
+    """A measurement CSV (see the module docstring) in SI; with `sensor_units` (sensor → SI unit of the result
+    file) only the columns named after those sensors are read and checked, the others are left out."""
+    return read_measured(path, sensor_units, first_column_time=True, mappable=False, min_samples=MIN_SAMPLES,
+                         sensors_of=sensors_of)
 
 
-def _rows(path: Path) -> list[list[str]]:
-    if not path.exists():
-        raise PlotInputError(f"no such file: {path}")
-    try:
-        with path.open(newline="", encoding="utf-8") as handle:
-            return [row for row in csv.reader(handle) if row and not row[0].lstrip().startswith("#")]
-    except (OSError, UnicodeDecodeError) as exc:
-        raise PlotInputError(f"cannot read the measurement {path}: {exc}") from None
+def run_sensor_units(run: RunData) -> dict:
+    """Sensor → unit (SI) of a result file's sensors, as the record's columns are checked against."""
+    return {name: run.unit(f"sensors/{name}") for name in run.sensors()}
 
 
-def _split_header(cell: str) -> tuple[str, str]:
-    match = HEADER.match(cell)
-    return (match["name"], (match["unit"] or "").strip()) if match else (cell.strip(), "")
-
-
-def _factor(unit: str, to_unit: str, where: str) -> float:
-    from clearsim.units import registry
-
-    if not unit:
-        return 1.0
-    try:
-        return float(registry().Quantity(1.0, unit).to(to_unit).magnitude)
-    except Exception as exc:  # pint raises several types for unknown or mismatched units
-        raise PlotInputError(f"{where}: cannot convert '{unit}' to {to_unit} ({exc})") from None
-
-
-def read_measurement(path: Path | str) -> Measurement:
-    """Columns of a measurement CSV (see the module docstring), time converted to seconds."""
-    path = Path(path)
-    rows = _rows(path)
-    if len(rows) < 3:
-        raise PlotInputError(f"{path}: expected a header row and at least two rows of numbers")
-    header = [_split_header(cell) for cell in rows[0]]
-    try:
-        numbers = np.array([[float(v) for v in row] for row in rows[1:]], dtype=float)
-    except ValueError:
-        raise PlotInputError(f"{path}: a value below the header is not a number") from None
-    names = [name for name, _ in header]
-    t_index = names.index("time") if "time" in names else 0
-    time = numbers[:, t_index] * _factor(header[t_index][1], "s", f"{path}: column '{names[t_index]}'")
-    columns = {name: (numbers[:, k], unit) for k, (name, unit) in enumerate(header) if k != t_index}
-    return Measurement(path, time, columns)
-
-
-def matched_sensors(measurement: Measurement, runs: list[RunData], chosen: list[str]) -> list[str]:
+def matched_sensors(measurement: MeasuredData, runs: list[RunData], chosen: list[str]) -> list[str]:
     """Sensors both measured and simulated (restricted to `chosen` when given)."""
     simulated = set(runs[0].sensors())
-    names = [n for n in measurement.columns if n in simulated and (not chosen or n in chosen)]
+    names = [n for n in measurement.values if n in simulated and (not chosen or n in chosen)]
     if not names:
         raise PlotInputError(f"{measurement.path}: no column is named after a sensor of {runs[0].path} "
-                             f"(columns: {', '.join(measurement.columns)}; sensors: {', '.join(sorted(simulated))})")
+                             f"(columns: {', '.join(measurement.values)}; sensors: {', '.join(sorted(simulated))})")
     return names
 
 
-def measured_si(measurement: Measurement, sensor: str, run: RunData) -> np.ndarray:
-    values, unit = measurement.columns[sensor]
-    return values * _factor(unit, run.unit(f"sensors/{sensor}"), f"{measurement.path}: column '{sensor}'")
+def measured_si(measurement: MeasuredData, sensor: str, run: RunData) -> np.ndarray:
+    return measurement.values[sensor]
 
 
 def residual(run: RunData, sensor: str, time: np.ndarray, measured: np.ndarray):
@@ -103,16 +67,20 @@ def wrap_label(text: str, width: int = 24) -> str:
     return "\n".join(textwrap.wrap(text, width))
 
 
-def within(measurement: Measurement, window: tuple[float, float] | None) -> Measurement:
+def within(measurement: MeasuredData, window: tuple[float, float] | None) -> MeasuredData:
     """The samples of the measurement inside a time window (s)."""
     if window is None:
         return measurement
     inside = (measurement.time >= window[0]) & (measurement.time <= window[1])
-    columns = {name: (values[inside], unit) for name, (values, unit) in measurement.columns.items()}
-    return Measurement(measurement.path, measurement.time[inside], columns)
+    if np.count_nonzero(inside) < MIN_SAMPLES:
+        raise PlotInputError(f"{measurement.path}: fewer than {MIN_SAMPLES} samples in the time window "
+                             f"{window[0] * 1e3:g}:{window[1] * 1e3:g} ms (the record covers "
+                             f"{measurement.time[0] * 1e3:g} to {measurement.time[-1] * 1e3:g} ms); widen --time-window")
+    values = {name: v[inside] for name, v in measurement.values.items()}
+    return replace(measurement, time=measurement.time[inside], values=values)
 
 
-def plot_measured(runs: list[RunData], measurement: Measurement, sensor: str, ax=None, residual_ax=None):
+def plot_measured(runs: list[RunData], measurement: MeasuredData, sensor: str, ax=None, residual_ax=None):
     """Simulation(s) and measurement on `ax`; the residual(s) on `residual_ax` when given."""
     ax = axes_or_new(ax)
     unit = runs[0].unit(f"sensors/{sensor}")
@@ -137,7 +105,7 @@ def plot_measured(runs: list[RunData], measurement: Measurement, sensor: str, ax
     return ax
 
 
-def measured_figure(runs: list[RunData], measurement: Measurement, sensors: list[str], interactive: bool = False):
+def measured_figure(runs: list[RunData], measurement: MeasuredData, sensors: list[str], interactive: bool = False):
     figure = new_figure((8.0, 3.6 * len(sensors) + 0.8), interactive)
     grid = figure.add_gridspec(2 * len(sensors), 1, height_ratios=[2.0, 1.0] * len(sensors))
     for k, sensor in enumerate(sensors):

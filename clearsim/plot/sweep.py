@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,6 +17,7 @@ from clearsim.plot.data import PlotInputError
 from clearsim.plot.style import IDEAL_STYLE, RUN_COLOURS, axes_or_new, new_figure, set_title
 
 SUMMARY = "summary.csv"
+BACKUP = re.compile(r"\.previous(-\d+)?\.h5$")  # a case's earlier result, kept by a re-run (docs/sweeps.md §4)
 BOOKKEEPING = {"case", "reference", "status", "error", "reused", "steps", "rejected_steps", "wall_time_s"}
 MERITS = {  # column → (axis label, factor from the CSV's unit to the axis unit)
     "peak_acceleration_m_s2": ("peak |output acceleration| (m/s²)", 1.0),
@@ -29,7 +31,7 @@ MAX_GROUPS = 8  # more combinations of the other swept quantities: points withou
 def result_files(folder: Path) -> list[Path]:
     """The folder's result files, the ideal case first, then by name."""
     files = sorted(folder.glob("*.h5"), key=lambda p: (not p.stem.startswith("ideal"), p.name))
-    files = [f for f in files if not f.name.endswith(".previous.h5")]
+    files = [f for f in files if not BACKUP.search(f.name)]
     if not files:
         raise PlotInputError(f"{folder} contains no result files (*.h5)")
     return files
@@ -138,12 +140,18 @@ def merit_figure(summary: Summary, title: str, interactive: bool = False):
     return figure
 
 
-def summary_of(folder: Path) -> Summary | None:
-    """The folder's summary when it has one with a numeric swept quantity and complete cases."""
+def summary_of(folder: Path, notes: list | None = None) -> Summary | None:
+    """The folder's summary when it has one with a numeric swept quantity and complete cases; one that cannot be
+    read gives no merit figure and a note (the runs are still plotted)."""
     path = folder / SUMMARY
     if not path.exists():
         return None
-    summary = read_summary(path)
+    try:
+        summary = read_summary(path)
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        if notes is not None:
+            notes.append(f"{path} cannot be read ({exc}): no figure of merit; run the sweep again to rewrite it")
+        return None
     if not summary.parameters or not any(not math.isnan(r[summary.parameters[0]]) for r in summary.rows):
         return None
     return summary

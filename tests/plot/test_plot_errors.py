@@ -87,17 +87,157 @@ def test_bad_options(runs, tmp_path, option, value, fragment):
 def test_measurement_without_matching_columns(runs, tmp_path):
     csv = tmp_path / "bench.csv"
     csv.write_text("time [s],pressure [bar]\n0,1\n0.001,2\n")
-    assert "no column is named after a sensor" in fails(tmp_path, runs["clearance"], "--measured", csv)
+    message = fails(tmp_path, runs["clearance"], "--measured", csv)
+    assert f"bench.csv: no column names a sensor of {runs['clearance']}" in message and "--map" not in message
 
 
 def test_measurement_with_a_wrong_unit(runs, tmp_path):
     csv = tmp_path / "bench.csv"
     csv.write_text("time [ms],slider_displacement [kg]\n0,1\n1,2\n")
     message = fails(tmp_path, runs["clearance"], "--measured", csv)
-    assert "column 'slider_displacement': cannot convert 'kg' to m" in message
+    assert "column 'slider_displacement': unit [kg] does not fit (expected a length" in message
 
 
 def test_draw_of_a_missing_config(tmp_path):
     result = runner.invoke(app, ["draw", str(tmp_path / "absent.yaml"), "-o", str(tmp_path / "d.png")])
     assert result.exit_code == 2 and "Traceback" not in result.output and "cannot read the file" in result.output
     assert not (tmp_path / "d.png").exists()
+
+
+def _rows(function, n=30):
+    return "".join(f"{','.join(map(str, function(k)))}\n" for k in range(n))
+
+
+@pytest.mark.parametrize("text, fragment", [
+    ("time [ms],slider_displacement [mm],slider_displacement [m]\n" + _rows(lambda k: (k, -k, -k / 1e3)),
+     "bench.csv:1: columns 2 and 3 are both named 'slider_displacement'; which one is meant is ambiguous"),
+    ("time [ms],slider_displacement [mm]\n" + _rows(lambda k: (k, 0.0)),
+     "bench.csv: column 'slider_displacement' is constant (0 mm in all 30 samples): a dead channel"),
+    ("time [ms],slider_displacement [mm]\n" + _rows(lambda k: (k, "nan")),
+     "bench.csv: column 'slider_displacement' holds no numbers (all 30 values are NaN or empty): a dead channel"),
+    ("time [ms],slider_displacement [mm]\n" + _rows(lambda k: (k * (1e3 if k > 9 else 1), -k)),
+     "bench.csv:3: time in column 'time' goes from 0 to 1 ms, a step 0.001 times the usual one of 1e+03 ms"),
+    ("time [ms],slider_displacement [mm]\n" + _rows(lambda k: (k if k != 5 else 2, -k)),
+     "bench.csv:7: time in column 'time' does not increase (4 then 2)"),
+    ("time [ms],slider_displacement [mm]\n" + _rows(lambda k: (k, "x" if k == 3 else -k)),
+     "bench.csv:5: column 'slider_displacement': 'x' is not a number"),
+    ("time [ms],slider_displacement [mm]\n", "bench.csv: no samples below the header"),
+    ("", "bench.csv: the file is empty"),
+], ids=["same name twice", "constant", "all NaN", "time unit changes", "time goes back", "not a number", "header only",
+        "empty"])
+def test_a_bad_measurement_gets_the_checks_of_diagnose(runs, tmp_path, text, fragment):
+    csv = tmp_path / "bench.csv"
+    csv.write_text(text)
+    assert fragment in fails(tmp_path, runs["clearance"], "--measured", csv)
+
+
+def test_a_measurement_that_is_not_utf8_or_a_folder(runs, tmp_path):
+    csv = tmp_path / "bench.csv"
+    csv.write_bytes(b"time [ms],slider_displacement [\xb5m]\n0,1\n1,2\n")
+    assert "bench.csv:1: byte 0xb5 is not UTF-8 text" in fails(tmp_path, runs["clearance"], "--measured", csv)
+    assert "is a folder; give the measured record itself" in fails(tmp_path, runs["clearance"], "--measured", tmp_path)
+
+
+def test_a_measurement_with_semicolons_is_plotted(runs, tmp_path):
+    csv = tmp_path / "bench.csv"
+    csv.write_text("time (ms);slider_displacement (mm)\n" + _rows(lambda k: (k / 10, -k / 10)).replace(",", ";"))
+    result = runner.invoke(app, ["plot", str(runs["clearance"]), "--out", str(tmp_path), "--measured", str(csv)])
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "sc-measured.png").exists()
+
+
+def _rewritten(source, path, change):
+    shutil.copy(source, path)
+    with h5py.File(path, "r+") as handle:
+        change(handle)
+    return path
+
+
+def _replace(handle, key, values):
+    del handle[key]
+    handle.create_dataset(key, data=values)
+
+
+@pytest.mark.parametrize("change, fragment", [
+    (lambda h: _replace(h, "time", [[0.0, 1.0], [2.0, 3.0]]),
+     "bad.h5: dataset /time is not a column of numbers (shape (2, 2), type float64)"),
+    (lambda h: _replace(h, "time", [b"a", b"b", b"c"]), "bad.h5: dataset /time is not a column of numbers"),
+    (lambda h: _replace(h, "time", [0.0]), "bad.h5: dataset /time holds 1 sample(s), too few to plot"),
+    (lambda h: _replace(h, "sensors/slider_velocity", [0.0, 1.0, 2.0]),
+     "bad.h5: dataset /sensors/slider_velocity has 3 samples, /time has"),
+], ids=["time 2-D", "time text", "one sample", "a dataset cut short"])
+def test_a_damaged_result_file_is_named_with_the_dataset(runs, tmp_path, change, fragment):
+    bad = _rewritten(runs["clearance"], tmp_path / "bad.h5", change)
+    message = fails(tmp_path, bad)
+    assert fragment in message and "run it again" in message
+
+
+def test_a_truncated_or_overwritten_result_file(runs, tmp_path):
+    data = runs["clearance"].read_bytes()
+    cut = tmp_path / "cut.h5"
+    cut.write_bytes(data[: len(data) // 2])
+    assert "cut.h5 is not a readable HDF5 file" in fails(tmp_path, cut) and "cut short or damaged" in fails(tmp_path, cut)
+    spoiled = tmp_path / "spoiled.h5"
+    spoiled.write_bytes(data[:4000] + b"\xff" * 20000 + data[24000:])
+    message = fails(tmp_path, spoiled)
+    assert "spoiled.h5" in message and "run it again" in message
+
+
+def test_an_incomplete_file_whose_datasets_end_apart_is_plotted_to_their_common_end(runs, tmp_path):
+    def cut_short(handle):
+        handle.attrs["complete"], handle.attrs["status"] = False, "interrupted"
+        _replace(handle, "joints/slider_pin/mode", handle["joints/slider_pin/mode"][:100])
+    partial = _rewritten(runs["clearance"], tmp_path / "partial.h5", cut_short)
+    result = runner.invoke(app, ["plot", str(partial), "--out", str(tmp_path / "figures")])
+    assert result.exit_code == 0, result.output
+    output = " ".join(result.output.split())
+    assert "partial.h5: the datasets of this incomplete file end at different samples (/joints/slider_pin/mode has " \
+           "100, /time" in output and "plotted the first 100" in output
+    assert "partial.h5 is incomplete (interrupted)" in output
+
+
+def test_a_sweep_folder_with_a_damaged_case_plots_the_others_and_names_it(runs, tmp_path):
+    folder = tmp_path / "sweep"
+    folder.mkdir()
+    shutil.copy(runs["ideal"], folder / "ideal.h5")
+    shutil.copy(runs["clearance"], folder / "slider_pin-0.5mm.h5")
+    (folder / "slider_pin-0.25mm.h5").write_bytes(b"")
+    (folder / "slider_pin-0.1mm.h5").write_bytes(runs["small"].read_bytes()[:5000])
+    (folder / "summary.csv").write_bytes(b"\xff\xfe not text")
+    shutil.copy(runs["small"], folder / "slider_pin-0.5mm.previous-2.h5")  # a kept backup is not a case
+    result = runner.invoke(app, ["plot", str(folder), "--out", str(tmp_path / "figures")])
+    assert result.exit_code == 0, result.output
+    output = " ".join(result.output.split())
+    assert "skipped case slider_pin-0.25mm:" in output and "skipped case slider_pin-0.1mm:" in output
+    assert "summary.csv cannot be read" in output and "Traceback" not in output
+    assert "previous-2" not in output
+    assert (tmp_path / "figures" / "sweep-output.png").exists()
+
+
+def test_a_sweep_folder_whose_every_case_is_damaged(tmp_path):
+    folder = tmp_path / "sweep"
+    folder.mkdir()
+    (folder / "ideal.h5").write_bytes(b"")
+    message = fails(tmp_path, folder)
+    assert f"{folder}: no case file can be plotted" in message and "ideal.h5 is not an HDF5 file" in message
+
+
+def test_a_file_whose_stored_mechanism_cannot_be_read_is_plotted_with_a_note(runs, tmp_path):
+    odd = _rewritten(runs["clearance"], tmp_path / "odd.h5", lambda h: h.attrs.__setitem__("config_yaml", "{{{"))
+    result = runner.invoke(app, ["plot", str(odd), "--out", str(tmp_path / "figures")])
+    assert result.exit_code == 0, result.output
+    assert "odd.h5: its stored mechanism (config_yaml) cannot be read" in " ".join(result.output.split())
+
+
+@pytest.mark.parametrize("window", ["nan:5", "1:inf", "nan:nan"])
+def test_a_time_window_that_is_not_finite(runs, tmp_path, window):
+    assert f"--time-window '{window}': expected finite times" in fails(tmp_path, runs["clearance"], "--time-window", window)
+
+
+def test_an_output_folder_that_is_a_file(runs, tmp_path):
+    notes = tmp_path / "notes.txt"
+    notes.write_text("mine")
+    result = runner.invoke(app, ["plot", str(runs["clearance"]), "--out", str(notes)])
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert f"--out {notes}: is a file, not a folder; give the folder for the figures" in " ".join(result.output.split())
+    assert notes.read_text() == "mine"

@@ -7,8 +7,7 @@ from pathlib import Path
 from typing import Callable
 
 from clearsim.errors import ClearsimError
-from clearsim.sweep.grid import SweepOptionError
-from clearsim.sweep.plan import CASES_FILE, SweepPlan, write_cases
+from clearsim.sweep.plan import SweepPlan, check_folder, write_cases
 from clearsim.sweep.summary import (PERCENTILES_FILE, SUMMARY_FILE, percentile_header, percentiles,
                                     summary_rows, write_csv)
 from clearsim.sweep.worker import (COMPLETE, FAILED, INTERRUPTED, NOT_RUN, CaseOutcome, CaseTask, finished_outcome,
@@ -56,7 +55,7 @@ def run_sweep(plan: SweepPlan, executor, progress: Progress | None = None,
     Ctrl-C stops the sweep: finished cases stay, the summary lists the others as not run, and
     KeyboardInterrupt is raised again once the files are written.
     """
-    _check_folder(plan.folder)
+    check_folder(plan.folder, plan.config, plan.config_text)
     executor.connect()
     plan.folder.mkdir(parents=True, exist_ok=True)
     write_cases(plan)
@@ -86,13 +85,6 @@ def recovered(tasks: list[CaseTask], outcomes: dict[str, CaseOutcome]) -> dict[s
     never reached this process (or said interrupted), read back from their complete files."""
     unsettled = [t for t in tasks if t.name not in outcomes or outcomes[t.name].state in (INTERRUPTED, NOT_RUN)]
     return {t.name: outcome for t in unsettled if (outcome := finished_outcome(t)) is not None}
-
-
-def _check_folder(folder: Path) -> None:
-    """A sweep writes into a new folder or one of its own (with cases.json), never among other files."""
-    if folder.exists() and (not folder.is_dir() or (any(folder.iterdir()) and not (folder / CASES_FILE).exists())):
-        raise SweepOptionError(f"--out {folder}: not a sweep folder (it holds other files and no {CASES_FILE})\n"
-                               "  hint: give a new folder, or leave out --out for one under results/")
 
 
 def _summarize(plan: SweepPlan, outcomes: dict[str, CaseOutcome], interrupted: bool) -> SweepResult:

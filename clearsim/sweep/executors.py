@@ -19,6 +19,7 @@ from clearsim.sweep.grid import SweepOptionError
 from clearsim.sweep.worker import FAILED, CaseOutcome, CaseTask, init_pool_worker
 
 Collect = Callable[[CaseOutcome], None]
+MAX_WORKERS_PER_CORE = 4  # a case is compiled code using one core: more processes only add memory
 
 
 def available_cores() -> int:
@@ -39,6 +40,12 @@ class LocalPool:
     def __init__(self, workers: int | None = None):
         if workers is not None and workers < 1:
             raise SweepOptionError(f"--workers must be at least 1, got {workers}")
+        cores = available_cores()
+        if workers is not None and workers > MAX_WORKERS_PER_CORE * cores:
+            raise SweepOptionError(f"--workers {workers}: this machine gives clearsim {cores} core"
+                                   f"{'s' if cores > 1 else ''}; more than {MAX_WORKERS_PER_CORE * cores} processes "
+                                   "only share them, and each holds its own copy of the compiled kernels (~200 MB)\n"
+                                   f"  hint: --workers {cores}, or leave the option out (one process per core)")
         self.workers = workers or available_cores()
         self._pool, self._stop = None, None
 
@@ -133,6 +140,31 @@ def _result(future, task: CaseTask) -> CaseOutcome:
         return _lost(task, exc)
 
 
+CONNECT_TIMEOUT = 10  # seconds: an address that answers nothing is reported, not waited on
+SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+ADDRESS_HINT = "hint: the scheduler's address as `dask scheduler` prints it, e.g. --scheduler tcp://192.168.1.10:8786"
+
+
+def check_address(address: str) -> str:
+    """The --scheduler address if it can name a scheduler (scheme://host:port); a malformed one is reported at once,
+    before the cases are planned and without trying to connect."""
+    text = address.strip()
+    scheme, separator, rest = text.partition("://")
+    if not separator:
+        scheme, rest = "tcp", text
+    if scheme not in SCHEMES:
+        raise SweepOptionError(f"--scheduler {address!r}: unknown scheme {scheme + '://'!r}; expected one of "
+                               f"{', '.join(s + '://' for s in SCHEMES)}\n  {ADDRESS_HINT}")
+    host, colon, port = rest.rpartition(":")
+    bracketed = host.startswith("[") == host.endswith("]")  # an IPv6 host is written [::1]
+    if not colon or not host.strip("[]") or not bracketed or "/" in rest:
+        raise SweepOptionError(f"--scheduler {address!r}: expected host:port after the scheme\n  {ADDRESS_HINT}")
+    if not (port.isascii() and port.isdigit() and 1 <= int(port) <= 65535):
+        raise SweepOptionError(f"--scheduler {address!r}: the port {port!r} is not a number from 1 to 65535\n"
+                               f"  {ADDRESS_HINT}")
+    return text if separator else f"tcp://{text}"
+
+
 class DaskCluster:
     """An existing dask.distributed cluster at `address` (tcp://host:8786); its workers need clearsim
     installed and the sweep folder on a shared file system at the same path."""
@@ -141,7 +173,7 @@ class DaskCluster:
         if workers is not None:
             raise SweepOptionError("--workers sizes the local pool; a Dask cluster runs as many cases "
                                    "at once as its workers have threads")
-        self.address = address
+        self.address = check_address(address)
         self.client = None
 
     def describe(self) -> str:
@@ -164,8 +196,8 @@ class DaskCluster:
         except ImportError:
             raise SweepOptionError("--scheduler needs dask.distributed: pip install 'dask[distributed]'") from None
         try:
-            return Client(self.address, timeout="10s")
-        except (OSError, TimeoutError, ValueError) as exc:
+            return Client(self.address, timeout=f"{CONNECT_TIMEOUT}s")
+        except Exception as exc:  # noqa: BLE001 — OSError, TimeoutError, ValueError, and distributed's own assertions
             raise SweepOptionError(f"--scheduler: cannot reach the Dask scheduler at {self.address} ({exc})\n"
                                    "  hint: start one with `dask scheduler` and workers with `dask worker ADDRESS`") from None
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from clearsim.errors import InputError, Problem
-from clearsim.sweep.grid import IDEAL, Case, joint_of
+from clearsim.sweep.grid import IDEAL, Case, SweepOptionError, joint_of
 from clearsim.units import parse_quantity
 
 SIGNIFICANT = 6
@@ -47,7 +47,11 @@ def _truncated_normal(rng, mean: float, std: float, low: float, high: float) -> 
         value = rng.normal(mean, std)
         if low <= value <= high:
             return value
-    return float(np.clip(mean, low, high))
+    raise OutsideBounds(f"mean {mean:g} ± std {std:g} almost never falls within [{low:g}, {high:g}]")
+
+
+class OutsideBounds(ValueError):
+    """A truncated normal whose bounds hold (almost) none of its distribution."""
 
 
 def sample_cases(tolerances, count: int, seed: int, fixed: list[str], zeroed: list[str],
@@ -58,7 +62,13 @@ def sample_cases(tolerances, count: int, seed: int, fixed: list[str], zeroed: li
     width = max(4, len(str(count)))
     for k in range(count):
         rng = np.random.default_rng([seed, k])
-        values = {t.path: draw(t, rng) for t in tolerances}
+        values = {}
+        for index, tolerance in enumerate(tolerances):
+            try:
+                values[tolerance.path] = draw(tolerance, rng)
+            except OutsideBounds as exc:  # was: the mean clipped to a bound, so every sample the same
+                raise SweepOptionError(f"--sample: tolerances[{index}] ({tolerance.path}): {exc} (in the unit of its "
+                                       "mean)\n  hint: check the mean, std, low and high of that tolerance") from None
         overrides = tuple(f"{path}={text}" for path, text in values.items())
         cases.append(Case(f"sample-{k + 1:0{width}d}", values, (*fixed, *overrides), False,
                           IDEAL if with_ideal else None))

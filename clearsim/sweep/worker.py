@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from clearsim.errors import ClearsimError
-from clearsim.io.hdf5 import NotAResultFile, ResultWriteError, read_result
+from clearsim.io.hdf5 import NotAResultFile, ResultWriteError, keep_as_previous, read_result
 from clearsim.model.loader import load_mechanism_text
 from clearsim.runner import prepare, run_to_file
 from clearsim.sweep.figures import CaseRecord, read_record
@@ -160,5 +160,5 @@ def _reusable(output: Path, resolved_yaml: str, retry_failed: bool) -> bool:
     if same:
         output.unlink()  # interrupted, or failed and retried: this case's own file, nothing worth keeping
     else:
-        output.replace(output.with_name(f"{output.stem}.previous{output.suffix}"))  # written from another YAML
+        keep_as_previous(output)  # written from another YAML: kept, never over an older kept one
     return False

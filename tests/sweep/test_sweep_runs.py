@@ -166,12 +166,13 @@ def test_a_case_whose_file_cannot_be_written_fails_with_the_reason_and_the_other
 
 def test_a_case_run_at_a_tolerance_too_coarse_for_its_contacts_is_named_with_its_warning(tmp_path, pool_sweep):
     out = tmp_path / "coarse"
-    result = invoke("sweep", SLIDER_CRANK, "--set", "solver.rtol=1e-4,1e-7", "--set", "solver.atol=1e-7",
+    # the first impact (not chaotic: the same on every machine) at a position tolerance of 1 mm, 13× its penetration
+    result = invoke("sweep", SLIDER_CRANK, "--set", "solver.atol=1e-3,1e-10", "--set", "solver.t_end=0.4ms",
                     "--workers", 2, "-o", out)
     assert result.exit_code == 0, result.output
     rows = read_summary(out)
     warned = [case for case, row in rows.items() if row["warnings"]]
-    assert warned == ["solver.rtol-1e-4"], rows.keys()
+    assert warned == ["solver.atol-1e-3"], rows.keys()
     assert "not resolved by the solver tolerance" in rows[warned[0]]["warnings"]
     assert f"warning: 1 case with results the solver could not vouch for ({warned[0]})" in result.output
     assert all(not row["warnings"] for row in read_summary(pool_sweep[0]).values())  # default tolerances: none

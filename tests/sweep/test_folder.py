@@ -1,0 +1,87 @@
+"""The sweep folder: one config's sweep per folder, and a re-run never overwrites a result kept earlier."""
+
+import json
+from pathlib import Path
+
+import h5py
+from typer.testing import CliRunner
+
+from clearsim.cli import app
+from clearsim.sweep.worker import _reusable
+
+CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
+SLIDER_CRANK = CONFIGS / "slider_crank_flores.yaml"
+FRICTION = CONFIGS / "slider_crank_flores_friction.yaml"
+runner = CliRunner()
+
+
+def _sweep_folder(folder: Path, config: Path) -> dict:
+    """A folder as a sweep of `config` leaves it: cases.json and a case file."""
+    folder.mkdir()
+    (folder / "cases.json").write_text(json.dumps({"config": str(config), "cases": []}))
+    (folder / "ideal.h5").write_bytes(b"the other config's result")
+    return {p.name: p.read_bytes() for p in folder.iterdir()}
+
+
+def test_a_folder_holding_another_configs_sweep_is_refused_and_left_as_it_was(tmp_path):
+    folder = tmp_path / "sweep"
+    before = _sweep_folder(folder, SLIDER_CRANK)
+    result = runner.invoke(app, ["sweep", str(FRICTION), "--clearance", "0.1", "-o", str(folder)])
+    assert result.exit_code == 2, result.output
+    output = " ".join(result.output.split())
+    assert (f"error: --out {folder}: it holds the sweep of another config, {SLIDER_CRANK} ({folder / 'cases.json'}: "
+            f"\"config\"), not of {FRICTION}; the two would be mixed hint: give a new folder") in output
+    assert "Traceback" not in output and "sweep of" not in output.split("error:")[0]  # refused before it starts
+    assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
+
+
+def test_a_folder_whose_case_list_cannot_be_read_is_refused(tmp_path):
+    folder = tmp_path / "sweep"
+    _sweep_folder(folder, SLIDER_CRANK)
+    (folder / "cases.json").write_text("{\"config\": ")
+    result = runner.invoke(app, ["sweep", str(SLIDER_CRANK), "--clearance", "0.1", "-o", str(folder)])
+    assert result.exit_code == 2, result.output
+    output = " ".join(result.output.split())
+    assert f"--out {folder}: its cases.json cannot be read (JSONDecodeError" in output
+    assert f"delete {folder / 'cases.json'} and run again" in output and "Traceback" not in output
+
+
+def test_the_same_config_moved_or_copied_may_continue_its_sweep(tmp_path):
+    """The folder names the config by path; a copy of the same file elsewhere (a moved project) is the same sweep."""
+    import hashlib
+
+    from clearsim.sweep.plan import check_folder
+
+    folder = tmp_path / "sweep"
+    folder.mkdir()
+    text = SLIDER_CRANK.read_text()
+    (folder / "cases.json").write_text(json.dumps({"config": "/elsewhere/slider_crank_flores.yaml", "cases": [],
+                                                   "config_sha256": hashlib.sha256(text.encode()).hexdigest()}))
+    check_folder(folder, SLIDER_CRANK, text)  # the same text: accepted
+    try:
+        check_folder(folder, SLIDER_CRANK, text + "# edited\n")
+    except Exception as refused:
+        assert "holds the sweep of another config, /elsewhere/slider_crank_flores.yaml" in str(refused)
+    else:
+        raise AssertionError("another path with other text must be refused")
+
+
+def _result(path: Path, config_yaml: str) -> Path:
+    with h5py.File(path, "w") as handle:
+        handle.attrs["clearsim_version"] = "0"
+        handle.attrs["config_yaml"] = config_yaml
+        handle.attrs["complete"] = True
+        handle.attrs["status"] = "complete"
+    return path
+
+
+def test_a_result_of_another_yaml_is_kept_with_a_number_beside_the_earlier_kept_one(tmp_path):
+    output = _result(tmp_path / "case.h5", "second")
+    oldest = _result(tmp_path / "case.previous.h5", "first")
+    assert not _reusable(output, "third", retry_failed=False)
+    assert not output.exists()
+    assert h5py.File(oldest, "r").attrs["config_yaml"] == "first"  # the older kept result is untouched
+    assert h5py.File(tmp_path / "case.previous-2.h5", "r").attrs["config_yaml"] == "second"
+    _result(output, "third")
+    assert not _reusable(output, "fourth", retry_failed=False)
+    assert h5py.File(tmp_path / "case.previous-3.h5", "r").attrs["config_yaml"] == "third"

@@ -134,9 +134,10 @@ def run(
 ) -> None:
     """Simulate a mechanism and write its time histories to an HDF5 file."""
     from clearsim.io.hdf5 import ResultWriteError
-    from clearsim.runner import BUNDLED_CONFIG, prepare, run_to_file, summarize
+    from clearsim.runner import BUNDLED_CONFIG, check_output_path, prepare, run_to_file, summarize
     from clearsim.model.loader import load_mechanism
 
+    check_output_path(output, config or BUNDLED_CONFIG)
     loaded = load_mechanism(config or BUNDLED_CONFIG, overrides)
     _announce_compile()
     system = prepare(loaded)
@@ -187,10 +188,10 @@ def sweep(
     from clearsim.sweep import display
 
     request = SweepRequest(config, overrides, clearance, joints, sample, seed, not no_ideal, out, delay_fraction)
+    executor = DaskCluster(scheduler, workers) if scheduler is not None else LocalPool(workers)  # options first
     plan = plan_sweep(request, BUNDLED_CONFIG)
-    executor = DaskCluster(scheduler, workers) if scheduler else LocalPool(workers)
     console.print(display.opening_line(plan, executor.describe()), soft_wrap=True)
-    if not scheduler:
+    if scheduler is None:
         _announce_compile()
     progress, update = display.case_progress(errors, len(plan.cases))
     try:
@@ -292,6 +293,11 @@ def synthesize(
     from clearsim.runner import BUNDLED_CONFIG
 
     chosen = [name.strip() for name in (sensors or "").split(",") if name.strip()]
+    if sensors is not None and not chosen:
+        from clearsim.diagnose.synthesize import SynthesisError
+
+        raise SynthesisError(f"--sensors {sensors!r}: names no sensor; give sensor names such as "
+                             "--sensors sealing_rod_displacement,turn_arm_angular_velocity, or leave the option out")
     record = make_record(SynthesisRequest(config or BUNDLED_CONFIG, overrides, chosen, rate, noise, lowpass,
                                           trigger_offset, seed, output, force))
     console.print(f"{record.output}: {len(record.time)} samples of {', '.join(record.values)} "

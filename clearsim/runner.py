@@ -16,7 +16,8 @@ import numpy as np
 
 from clearsim.assembly.build import BuildError
 from clearsim.assembly.system import System, assemble
-from clearsim.errors import InputError, SolverError, format_path
+from clearsim.errors import ClearsimError, InputError, SolverError, format_path
+from clearsim.io.files import same_file
 from clearsim.io.hdf5 import (
     ResultWriter, check_free_space, group_attribute, interrupts_deferred, keep_existing, read_result, write_failure,
 )
@@ -27,6 +28,27 @@ from clearsim.solver import precompile
 
 BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
 DEFAULT_OUTPUT = Path("results") / "run.h5"
+RESULT_SUFFIXES = (".h5", ".hdf5", ".hdf")
+
+
+class OutputPathError(ClearsimError):
+    """An -o that cannot be a result file (a folder, the mechanism file itself, not an HDF5 name)."""
+
+
+def check_output_path(output: Path, config: Path) -> None:
+    """Refuse, before anything runs, an output that would move a folder or the config aside, or put HDF5 in a
+    file named as something else (an existing file there is renamed to <stem>.1<suffix>, not overwritten)."""
+    output = Path(output)
+    hint = "hint: give a result file such as -o results/run.h5"
+    if output.is_dir():
+        raise OutputPathError(f"-o {output}: is a folder, not a result file\n  hint: name the file in it, e.g. "
+                              f"-o {output / 'run.h5'}")
+    if same_file(output, Path(config)):
+        raise OutputPathError(f"-o {output}: that is the mechanism file being run; the result would take its "
+                              f"place\n  {hint}")
+    if output.suffix.lower() not in RESULT_SUFFIXES:
+        raise OutputPathError(f"-o {output}: a result file is HDF5 and is named *.h5 (got "
+                              f"{output.suffix or 'no suffix'!r})\n  hint: e.g. -o {output.with_suffix('.h5')}")
 
 
 def prepare(loaded: LoadedMechanism) -> System:
@@ -100,10 +122,8 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
         pending = _PendingChunks(writer, episodes, system)
         try:
             run = Run(system)
-            for chunk in run.chunks():
+            for chunk in run.chunks(progress):
                 pending.add(chunk, run)
-                if progress is not None:
-                    progress(run.time)
         except SolverError as exc:
             exc.place = element_place(loaded, exc.element)
             status, complete, error = f"failed: {exc}", False, exc
@@ -213,8 +233,8 @@ def summarize(path: Path) -> Summary:
     peak = {}
     for role in ("velocity", "acceleration"):
         name = output.get(role)
-        key = f"sensors/{name}"
-        peak[role] = (name, float(np.max(np.abs(data[key])))) if name and key in data and len(data[key]) else None
+        values = _finite(data.get(f"sensors/{name}", NO_SAMPLES)) if name else NO_SAMPLES
+        peak[role] = (name, float(np.max(np.abs(values)))) if len(values) else None
     joints = [j for j in str(data["attrs"].get("clearance_joints", "")).split(",") if j]
     forces = {j: _peak_contact_force(path, j, data.get(f"joints/{j}/normal_force", NO_SAMPLES)) for j in joints}
     shares = {}
@@ -227,10 +247,17 @@ def summarize(path: Path) -> Summary:
     return Summary(peak["velocity"], peak["acceleration"], forces, shares, sticking, warnings)
 
 
+def _finite(values: np.ndarray) -> np.ndarray:
+    """The finite samples: a run that failed as its state overflowed ends with NaN or inf samples, and its peaks are
+    those of the motion before (a NaN peak said nothing)."""
+    values = np.asarray(values, dtype=float)
+    return values[np.isfinite(values)]
+
+
 def _peak_contact_force(path: Path, joint: str, sampled: np.ndarray) -> float:
     """The larger of the sampled peak and the peak located within every step (which samples can miss)."""
-    tracked = group_attribute(path, f"joints/{joint}/episodes", "peak_normal_force_N", 0.0)
-    return max(float(tracked), float(np.max(sampled, initial=0.0)))
+    tracked = float(group_attribute(path, f"joints/{joint}/episodes", "peak_normal_force_N", 0.0))
+    return max(tracked if np.isfinite(tracked) else 0.0, float(np.max(_finite(sampled), initial=0.0)))
 
 
 def _output_sensors(config_yaml: str) -> dict:

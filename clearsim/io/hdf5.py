@@ -38,6 +38,17 @@ def keep_existing(path: Path) -> Path | None:
     return backup
 
 
+def keep_as_previous(path: Path) -> Path:
+    """Rename a result to <stem>.previous<suffix>, or the first free <stem>.previous-<k><suffix> (k = 2, 3, …) when
+    earlier ones exist: an older kept result is never overwritten. Returns the new name."""
+    path = Path(path)
+    backup, k = path.with_name(f"{path.stem}.previous{path.suffix}"), 2
+    while backup.exists():
+        backup, k = path.with_name(f"{path.stem}.previous-{k}{path.suffix}"), k + 1
+    path.rename(backup)
+    return backup
+
+
 @contextlib.contextmanager
 def interrupts_deferred():
     """Hold Ctrl-C and SIGTERM until the block ends, so a write is never cut in half (main thread only)."""

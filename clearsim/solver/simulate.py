@@ -181,8 +181,12 @@ class Run:
         return Chunk(times, states, modes, speeds, episodes, qdd, lam, contact,
                      energies[:, E_KINETIC], energies[:, E_POTENTIAL], energies[:, E_VIOLATION])
 
-    def chunks(self) -> Iterator[Chunk]:
-        """Integrate to t_end, yielding samples as they come; SolverError on failure (after the samples)."""
+    def chunks(self, progress: Callable[[float], None] | None = None) -> Iterator[Chunk]:
+        """Integrate to t_end, yielding samples as they come; SolverError on failure (after the samples).
+
+        progress(t) is called at every return of the compiled loop, with or without samples: a run with a tiny
+        max_step and a low output rate comes back every STEPS_PER_CALL steps without a sample, and its progress
+        bar must still move."""
         t_end = self.real[ig.R_T_END]
         next_stop = t_end / CHUNKS
         while True:
@@ -196,6 +200,8 @@ class Run:
             chunk = self._take_samples()
             if chunk is not None:
                 yield chunk
+            if progress is not None:
+                progress(self.time)
             if status == ig.DONE:
                 return
             if status == ig.CHUNK_END:
@@ -225,6 +231,12 @@ class Run:
                           "or solver.rtol too loose to resolve the impact (try 1e-7)"),
         }
         message, hint = messages[status]
+        if status == ig.MIN_STEP and all(mode == FREE for mode in self.modes):
+            # no contact is closed: the stiff or jumping force is elsewhere (found by the input fuzz: a mass of
+            # 1e300 kg stopped here with the contact hint)
+            hint = ("no clearance joint is in contact here, so it is not a contact: check masses, inertias, spring "
+                    "stiffnesses and forces for values off by orders of magnitude (a unit), and the drive's motion "
+                    "for a jump")
         return SolverError(message, time=t, element=joint, hint=hint)
 
     def _involved_joint(self, status: int) -> str | None:
@@ -262,8 +274,6 @@ def simulate(system: System, progress: Callable[[float], None] | None = None) ->
     """Run to t_end and return the History; SolverError propagates (use Run.chunks to keep partial results)."""
     run = Run(system)
     chunks = []
-    for chunk in run.chunks():
+    for chunk in run.chunks(progress):
         chunks.append(chunk)
-        if progress is not None:
-            progress(run.time)
     return History(system, join_chunks(chunks), run.episode_log(), run.statistics(), True, "complete")

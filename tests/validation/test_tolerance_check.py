@@ -2,7 +2,10 @@
 
 Session 5 found that at rtol 1e-4, atol 1e-7 m the frictionless slider-crank sinks a gentle contact 0.33 mm into
 the bearing (392 kN instead of 46 kN) and finishes without a word; the run now finishes with a warning naming the
-joint, and stays silent at the default tolerances, where the same contacts are resolved.
+joint, and stays silent at the default tolerances, where the same contacts are resolved. That gentle contact comes
+late in a chaotic impact sequence, so whether a run meets it depends on round-off (on session 8's machine the same
+run does not): the test takes the first impact, the same on every machine, at a position tolerance of 1 mm (13× its
+Hertz penetration).
 """
 
 from pathlib import Path
@@ -24,7 +27,7 @@ def run(tmp_path: Path, config: Path, *overrides: str):
 
 
 def test_a_tolerance_coarser_than_the_penetration_is_reported(tmp_path):
-    report = run(tmp_path, CONFIGS / "slider_crank_flores.yaml", "solver.rtol=1e-4", "solver.atol=1e-7")
+    report = run(tmp_path, CONFIGS / "slider_crank_flores.yaml", "solver.t_end=0.4ms", "solver.atol=1e-3")
     assert report.statistics.tolerance_over_penetration > 10.0
     assert len(report.warnings) == 1
     assert "not resolved by the solver tolerance" in report.warnings[0] and "joint slider_pin" in report.warnings[0]

@@ -227,6 +227,27 @@ class CartesianResult:
         times = np.arange(0.0, t_end + 0.5 * OUTPUT_PERIOD, OUTPUT_PERIOD)
         return float(max(abs(self.slider_acceleration(t)) for t in times))
 
+    def output_history(self, t_end: float) -> tuple[np.ndarray, np.ndarray]:
+        """(states, accelerations) on clearsim's output grid, as clearsim's run keeps them: each segment's dense
+        output called once for its samples, the augmented system solved at each (a sample on a switch belongs to the
+        segment that ends there and one past the last segment's end to the last segment, as in slider_acceleration)."""
+        p = self.parameters
+        mass = mass_matrix(p)
+        times = np.arange(0.0, t_end + 0.5 * OUTPUT_PERIOD, OUTPUT_PERIOD)
+        states = np.full((times.size, 2 * COORDINATES), np.nan)  # a grid point no segment holds stays NaN
+        qdd = np.full((times.size, COORDINATES), np.nan)
+        start = 0
+        for number, segment in enumerate(self.segments):  # a grid point past the end belongs to the last one
+            last = number == len(self.segments) - 1
+            stop = times.size if last else int(np.searchsorted(times, segment.t1, side="right"))
+            if stop > start:
+                block = segment.sol(times[start:stop]).T
+                states[start:stop] = block
+                for k, y in enumerate(block):
+                    qdd[start + k] = accelerations(p, mass, times[start + k], y, segment.impact_speed)
+                start = stop
+        return states, qdd
+
     def constraint_drift(self, t_end: float) -> float:
         """max |Φ| on the output grid (m or rad): what Baumgarte leaves of the constraint violation."""
         times = np.arange(0.0, t_end + 0.5 * OUTPUT_PERIOD, OUTPUT_PERIOD)
@@ -280,16 +301,20 @@ def first_impact(p: Parameters, t_end: float, rtol: float, atol: float) -> dict:
     return {"onset_s": onset, "impact_speed": speed, "peak_normal_force": force, "peak_time_s": when}
 
 
-def run(friction: bool, t_end: float, rtol: float, atol: float) -> dict:
+def run(friction: bool, t_end: float, rtol: float, atol: float, outputs: bool = False) -> dict:
     """One run: wall time (integration and max contact force, as the minimal baseline's), steps, the two figures.
 
     The peak slider acceleration on the output grid is taken after the clock stops, as in
-    benchmarks/solve_ivp_slider_crank.py; clearsim's wall includes its output sampling and HDF5 file.
+    benchmarks/solve_ivp_slider_crank.py; clearsim's wall includes its output sampling and HDF5 file. With
+    outputs=True the clock also covers the states and accelerations on the 100 kHz output grid (output_history):
+    the same outputs clearsim's in-memory run keeps, for the equal-output comparison.
     """
     p = FRICTION if friction else FRICTIONLESS
     started = time.perf_counter()
     result = simulate(p, t_end, rtol, atol)
     force, _ = result.max_contact_force()
+    if outputs:
+        result.output_history(t_end)
     wall = time.perf_counter() - started
     return {"rtol": rtol, "wall_s": wall, "steps": result.steps, "rhs_evaluations": result.rhs_evaluations,
             "contact_events": len(result.onsets), "max_contact_force": force,
@@ -345,15 +370,21 @@ def _as_accurate(row: dict, clearsim_errors: dict) -> bool:
 
 def timed_against_clearsim(friction: bool, clearsim_case, t_end: float, rtol: float, repeats: int, folder) -> dict:
     """Wall medians of the baseline at rtol and of clearsim's run of the case, alternated run by run, and their ratio."""
-    from benchmarks.suite import _run
+    from benchmarks.suite import _run, _run_in_memory
 
-    mine, theirs = [], []
+    mine, theirs, mine_equal, theirs_equal = [], [], [], []
     for k in range(repeats):  # alternated, so that a busy spell of the shared machine falls on both
         theirs.append(_run(clearsim_case.config, clearsim_case.overrides, folder, f"cartesian-clearsim-{k}")[0])
         mine.append(run(friction, t_end, rtol, ATOL_PER_RTOL * rtol)["wall_s"])
+        # equal outputs: both keep the 100 kHz states and accelerations and the max contact force in memory
+        theirs_equal.append(_run_in_memory(clearsim_case.config, clearsim_case.overrides)[0])
+        mine_equal.append(run(friction, t_end, rtol, ATOL_PER_RTOL * rtol, outputs=True)["wall_s"])
     return {"wall_median_s": statistics.median(mine), "wall_min_s": min(mine), "wall_max_s": max(mine),
             "clearsim_wall_median_s": statistics.median(theirs), "clearsim_wall_min_s": min(theirs),
-            "clearsim_wall_max_s": max(theirs), "ratio": statistics.median(mine) / statistics.median(theirs)}
+            "clearsim_wall_max_s": max(theirs), "ratio": statistics.median(mine) / statistics.median(theirs),
+            "equal_outputs_wall_median_s": statistics.median(mine_equal),
+            "clearsim_in_memory_wall_median_s": statistics.median(theirs_equal),
+            "ratio_equal_outputs": statistics.median(mine_equal) / statistics.median(theirs_equal)}
 
 
 def compare_case(friction: bool, clearsim, repeats: int, quick: bool, folder) -> dict:

@@ -84,6 +84,19 @@ def _run(config: Path, overrides, folder: Path, name: str):
     return wall, report, summary
 
 
+def _run_in_memory(config: Path, overrides) -> tuple[float, object]:
+    """The same run with its results kept in memory (`clearsim.solver.simulate.simulate`: load, assemble, integrate
+    with every output sample and its accelerations, multipliers and contact forces; no HDF5 file): (wall s, History).
+    What a peer or a baseline that keeps its outputs in memory does, for an equal-output comparison."""
+    from clearsim.model.loader import load_mechanism
+    from clearsim.runner import prepare
+    from clearsim.solver.simulate import simulate
+
+    started = time.perf_counter()
+    history = simulate(prepare(load_mechanism(config, list(overrides))))
+    return time.perf_counter() - started, history
+
+
 def _traced_run(config: Path, overrides, folder: Path) -> float:
     """The warm-up run under tracemalloc: peak traced memory in MB (numpy arrays included)."""
     import tracemalloc
@@ -217,7 +230,9 @@ def clearsim_ladder(case_name: str, repeats: int, folder: Path) -> list[dict]:
             rows.append({"rtol": rtol, "failed": str(failure)})
             continue
         peak, force = _figures(runs[-1][2])
+        in_memory = [_run_in_memory(case.config, settings)[0] for _ in range(repeats)]
         rows.append({"rtol": rtol, "wall_s": statistics.median(r[0] for r in runs),
+                     "wall_in_memory_s": statistics.median(in_memory),
                      "error_peak_acceleration": _relative(peak, ref_peak),
                      "error_max_contact_force": _relative(force, ref_force)})
     return rows
@@ -302,6 +317,12 @@ def side_by_side(document: dict):
                 out.add_row("", tool, setting(settled) + " and tighter", _wall(settled), f"{settled['error_peak_acceleration']:.1e}",
                             f"{settled['error_max_contact_force']:.1e}", f"{settled['ratio']:.1f}×")
                 out.add_row("", "clearsim (this run)", "rtol = 1e-7", f"{settled['clearsim_wall_median_s']:.3f} s", "", "", "")
+            for timed, rung, tighter in ((case, matched, ""), (settled, settled, " and tighter")):
+                if "ratio_equal_outputs" in timed:  # both keep the same outputs in memory: no HDF5 file on either side
+                    out.add_row("", tool + ", equal outputs", setting(rung) + tighter + ", + 100 kHz states and accelerations",
+                                f"{timed['equal_outputs_wall_median_s']:.3f} s", "", "", f"{timed['ratio_equal_outputs']:.1f}×")
+                    out.add_row("", "clearsim in memory", "rtol = 1e-7, no HDF5 file",
+                                f"{timed['clearsim_in_memory_wall_median_s']:.3f} s", "", "", "")
     return out
 
 
@@ -336,7 +357,7 @@ def at_peer_accuracy(document: dict):
     study = document.get("peer") or {}
     out = Table(title="clearsim at the peer's accuracy: each Exudyn step vs the loosest clearsim rtol as accurate in both errors")
     for column in ("case", "Exudyn step", "Exudyn wall", "err acc. / F_n", "clearsim rtol", "clearsim wall",
-                   "err acc. / F_n", "Exudyn / clearsim"):
+                   "err acc. / F_n", "Exudyn / clearsim", "clearsim in memory", "Exudyn / in memory"):
         out.add_column(column, justify="left" if column == "case" else "right")
     for case in study.get("cases", []):
         for row in case.get("at_peer_accuracy", []):
@@ -345,7 +366,9 @@ def at_peer_accuracy(document: dict):
                         f"{row['error_peak_acceleration']:.1e} / {row['error_max_contact_force']:.1e}",
                         f"{mine['rtol']:g}" if mine else "—", f"{mine['wall_s']:.3f} s" if mine else "",
                         f"{mine['error_peak_acceleration']:.1e} / {mine['error_max_contact_force']:.1e}" if mine else "",
-                        f"{row['ratio']:.1f}×" if mine else "")
+                        f"{row['ratio']:.1f}×" if mine else "",
+                        f"{mine['wall_in_memory_s']:.3f} s" if mine and "wall_in_memory_s" in mine else "",
+                        f"{row['ratio_in_memory']:.1f}×" if row.get("ratio_in_memory") else "")
     return out
 
 

@@ -49,6 +49,23 @@ def test_the_cartesian_baseline_states_both_errors_and_its_ratio(document):
         assert case["matched"]["error_max_contact_force"] <= clearsim[0]
         assert case["matched"]["error_peak_acceleration"] <= clearsim[1]
         assert case["ratio"] == pytest.approx(case["wall_median_s"] / case["clearsim_wall_median_s"])
+        assert case["ratio_equal_outputs"] == pytest.approx(case["equal_outputs_wall_median_s"]
+                                                            / case["clearsim_in_memory_wall_median_s"])
+
+
+def test_the_in_memory_run_is_the_file_run_without_its_file(tmp_path):
+    """The equal-output comparisons time clearsim without its HDF5 file: the same integration, step for step."""
+    from benchmarks.suite import CRANK, _run, _run_in_memory
+
+    settings = ("solver.t_end=2ms",)
+    _, report, _ = _run(CRANK, settings, tmp_path, "file")
+    wall, history = _run_in_memory(CRANK, settings)
+    mine, theirs = history.statistics, report.statistics
+    assert wall > 0.0 and history.complete
+    assert (mine.steps, mine.rejected_steps, mine.rhs_evaluations) == (theirs.steps, theirs.rejected_steps,
+                                                                        theirs.rhs_evaluations)
+    assert history.chunk.times.size == 201 and history.chunk.accelerations.shape[0] == 201  # 100 kHz over 2 ms
+    assert mine.peak_normal_force.tolist() == theirs.peak_normal_force.tolist()
 
 
 def test_the_peer_runs_or_says_how_to_install_it(document):
@@ -62,6 +79,9 @@ def test_the_peer_runs_or_says_how_to_install_it(document):
     assert first["exudyn"]["peak_normal_force"] == pytest.approx(first["minimal_model"]["peak_normal_force"], rel=1e-3)
     (case,) = peer["cases"]
     assert {"step_s", "error_max_contact_force", "error_peak_acceleration", "crank_speed_drift"} <= set(case["rows"][0])
+    for row in case["at_peer_accuracy"]:  # each against clearsim's file run and its in-memory run (equal outputs)
+        if row["clearsim"] is not None:
+            assert row["ratio_in_memory"] == pytest.approx(row["wall_s"] / row["clearsim"]["wall_in_memory_s"])
 
 
 def test_the_four_bar_chain_is_a_one_degree_of_freedom_mechanism_plus_its_clearance_joints():

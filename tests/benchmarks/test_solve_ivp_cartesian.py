@@ -45,3 +45,17 @@ def test_the_matched_rtol_is_the_loosest_as_accurate_as_clearsim_in_both_figures
     assert cartesian.matched_row(rows, clearsim)["rtol"] == 3e-7
     assert cartesian.settled_row(rows, clearsim)["rtol"] == 1e-8  # every tighter rung is as accurate too
     assert cartesian.matched_row(rows[2:3], clearsim) is None and cartesian.settled_row(rows[:3], clearsim) is None
+
+
+def test_the_output_history_is_the_per_sample_acceleration_on_the_whole_grid():
+    """The equal-output timing computes the 100 kHz accelerations per segment; they must be those the figures read
+    one sample at a time (slider_acceleration), on every point of the grid, switches included."""
+    p, t_end = FRICTIONLESS, 6e-4  # two contact switches
+    result = cartesian.simulate(p, t_end, 1e-8, cartesian.ATOL_PER_RTOL * 1e-8)
+    assert len(result.segments) >= 3
+    states, qdd = result.output_history(t_end)
+    times = np.arange(0.0, t_end + 0.5 * cartesian.OUTPUT_PERIOD, cartesian.OUTPUT_PERIOD)
+    assert qdd.shape == (times.size, cartesian.COORDINATES)
+    one_by_one = np.array([result.slider_acceleration(t) for t in times])
+    np.testing.assert_allclose(qdd[:, 6], one_by_one, rtol=1e-12, atol=1e-9)
+    assert np.max(np.abs(qdd[:, 6])) == pytest.approx(result.peak_slider_acceleration(t_end), rel=1e-12)

@@ -140,6 +140,8 @@ def test_bad_measured_data_is_one_message_and_exit_code_2(tmp_path, problem, con
     (["--lowpass", "10Hz"], "--lowpass '10Hz': below 2 cycles over the record (5.98 ms), the comparison would keep no "
      "independent samples; give at least 334 Hz"),
     (["--workers", "0"], "--workers must be at least 1, got 0"),
+    (["--scheduler", ""], "--scheduler '': expected host:port after the scheme"),  # was: ran on the local pool
+    (["--scheduler", "tcp://localhost:99999"], "the port '99999' is not a number from 1 to 65535"),
     (["-o", "{tmp}/notes.txt"], "notes.txt: is a file, not a folder; give the folder for the report"),
 ])
 def test_bad_options_are_one_message_and_exit_code_2(tmp_path, options, message):

@@ -20,6 +20,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from clearsim import __version__
+from clearsim.process import exit_without_final_collection
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="Planar mechanisms with clearance joints: simulate, sweep, plot, diagnose.")
@@ -43,6 +44,7 @@ def main(
     debug: bool = typer.Option(False, "--debug", help="Show tracebacks for errors."),
 ) -> None:
     _state["debug"] = debug
+    exit_without_final_collection()
 
 
 def _terminate(signum, frame):

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from clearsim.errors import ClearsimError
+from clearsim.process import exit_without_final_collection
 from clearsim.io.hdf5 import NotAResultFile, ResultWriteError, keep_as_previous, read_result
 from clearsim.model.loader import load_mechanism_text
 from clearsim.runner import prepare, run_to_file
@@ -56,6 +57,7 @@ def init_pool_worker(stop) -> None:
     _stop = stop
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     sys.unraisablehook = _quiet_interrupts
+    exit_without_final_collection()  # the pool's shutdown waits for its processes to end
 
 
 def _quiet_interrupts(unraisable) -> None:

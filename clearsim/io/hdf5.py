@@ -222,10 +222,13 @@ def read_result(path: Path, wanted: Callable[[str], bool] | None = None) -> dict
         out = {"attrs": dict(handle.attrs)}
 
         def keep(name, node):
-            if isinstance(node, h5py.Dataset) and (wanted is None or wanted(name)):
+            if isinstance(node, h5py.Dataset):
                 out[name] = node[()]
 
-        handle.visititems(keep)
+        if wanted is None:
+            handle.visititems(keep)
+        else:  # by name first: an h5py object for each of the file's groups and datasets costs more than the reading
+            handle.visit(lambda name: keep(name, handle[name]) if wanted(name) else None)
         return out
 
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from clearsim.io.hdf5 import read_result
-from clearsim.runner import summarize
+from clearsim.runner import summarize, summary_dataset
 
 NAN = math.nan
 
@@ -42,8 +42,8 @@ def _sensor(data: dict, name: str | None) -> np.ndarray | None:
 
 def read_record(path: Path, output) -> CaseRecord:
     """The record of a result file; `output` is the mechanism's OutputSensors."""
-    data = read_result(path)
-    summary = summarize(path)
+    data = read_result(path, lambda name: name == "time" or summary_dataset(name))
+    summary = summarize(path, data)
     attrs = data["attrs"]
     contact = {joint: (force, *summary.contact_time_share[joint]) for joint, force in summary.peak_contact_force.items()}
     return CaseRecord(

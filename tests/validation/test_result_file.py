@@ -98,7 +98,9 @@ def test_a_selective_read_and_the_summary_agree_with_the_whole_file(tmp_path):
     assert set(some) == {"attrs"} | {name for name in whole if name.startswith("sensors/")}
     for name in set(some) - {"attrs"}:
         assert np.array_equal(some[name], whole[name])
+    assert set(read_result(report.output, lambda name: name in ("bodies", "time"))) == {"attrs", "time"}  # no group
     summary = summarize(report.output)
+    assert summarize(report.output, whole) == summary  # from data already read (a sweep's record)
     assert summary.peak_acceleration == ("slider_acceleration",
                                          float(np.max(np.abs(whole["sensors/slider_acceleration"]))))
     mode = whole["joints/slider_pin/mode"]

@@ -21,7 +21,7 @@ from clearsim.io.files import same_file
 from clearsim.io.hdf5 import (
     ResultWriter, check_free_space, group_attribute, interrupts_deferred, keep_existing, read_result, write_failure,
 )
-from clearsim.model.loader import LoadedMechanism, load_mechanism
+from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
 from clearsim.solver.outputs import classify_episodes, chunk_outputs, sample_modes
 from clearsim.solver.simulate import Chunk, Run, Statistics
 from clearsim.solver import precompile
@@ -269,5 +269,5 @@ def _peak_contact_force(path: Path, joint: str, sampled: np.ndarray) -> float:
 def _output_sensors(config_yaml: str) -> dict:
     import yaml
 
-    document = yaml.load(config_yaml, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader)) or {}  # libyaml: 9× faster
+    document = yaml.load(config_yaml, Loader=FAST_LOADER) or {}
     return dict(document.get("output") or {})

@@ -14,6 +14,7 @@ Everything here is data-only arithmetic (docs/diagnose.md §"The gap" and §"Noi
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from scipy.optimize import minimize_scalar
@@ -125,8 +126,14 @@ def lowpass(values: np.ndarray, cutoff: float | None, rate: float) -> np.ndarray
     """Zero-phase 4th-order Butterworth low-pass, the comparison filter applied to model and record alike."""
     if cutoff is None or cutoff >= 0.5 * rate or len(values) <= 3 * (2 * COMPARISON_FILTER_ORDER + 1):
         return values
-    sos = butter(COMPARISON_FILTER_ORDER, cutoff, btype="low", fs=rate, output="sos")
-    return sosfiltfilt(sos, values)
+    return sosfiltfilt(np.array(comparison_filter(cutoff, rate)), values)
+
+
+@lru_cache(maxsize=64)
+def comparison_filter(cutoff: float, rate: float) -> tuple:
+    """The second-order sections of the comparison filter, designed once per cut-off and rate (a diagnosis filters
+    thousands of predictions with a few filters, and the design cost more than the filtering)."""
+    return tuple(map(tuple, butter(COMPARISON_FILTER_ORDER, cutoff, btype="low", fs=rate, output="sos")))
 
 
 @dataclass

@@ -16,9 +16,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from clearsim.errors import ClearsimError
-from clearsim.process import exit_without_final_collection
 from clearsim.io.hdf5 import NotAResultFile, ResultWriteError, keep_as_previous, read_result
 from clearsim.model.loader import load_mechanism_text
+from clearsim.process import exit_without_final_collection
 from clearsim.runner import prepare, run_to_file
 from clearsim.sweep.figures import CaseRecord, read_record
 

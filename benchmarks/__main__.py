@@ -2,4 +2,5 @@ import sys
 
 from benchmarks.suite import main
 
-sys.exit(main())
+if __name__ == "__main__":  # importing the module (a spawned worker, a tool) must not run the suite
+    sys.exit(main())

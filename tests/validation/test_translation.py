@@ -24,7 +24,8 @@ def test_the_motion_impacts_and_forces_do_not_depend_on_the_origin():
     """Accelerations, contact episodes and the peak contact force of the translated drawing equal the original's
     (the error norm weighs positions by their size, and 10 m coordinates loosen the position terms ~60×; the
     velocities' terms set the steps, so nothing may move beyond the solver tolerance)."""
-    here, there = (simulate(prepare(load_mechanism(CONFIGS / "slider_crank_flores.yaml", drawn_at(d)))) for d in (0.0, SHIFT))
+    config = CONFIGS / "slider_crank_flores.yaml"
+    here, there = (simulate(prepare(load_mechanism(config, drawn_at(d)))) for d in (0.0, SHIFT))
     assert len(there.episodes.onset) == len(here.episodes.onset) >= 10
     np.testing.assert_allclose(there.episodes.onset, here.episodes.onset, rtol=0, atol=1e-9)
     assert there.statistics.peak_normal_force == pytest.approx(here.statistics.peak_normal_force, rel=1e-6)

@@ -90,31 +90,39 @@ def test_an_existing_report_is_kept(hidden_clearance, tmp_path):
     assert (report / "diagnosis.1.json").read_text() == before  # the earlier one, renamed
 
 
+def rows(count: int, step: float = 0.02, start: float = 0, value=lambda k: k) -> str:
+    """`count` CSV rows "time,value": time start + k·step (in the header's unit), value(k)."""
+    return "".join(f"{start + k * step},{value(k)}\n" for k in range(count))
+
+
+SAWTOOTH = lambda k: k % 17  # noqa: E731 — a record that moves
+
+
 BAD_RECORDS = [
-    ("no sensor column", "time [ms],slider_displacment [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(300)),
+    ("no sensor column", "time [ms],slider_displacment [mm]\n" + rows(300),
      "did you mean 'slider_displacement'"),
-    ("no time column", "t [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(300)),
+    ("no time column", "t [ms],slider_displacement [mm]\n" + rows(300),
      "no time column"),
     ("time going back", "time [ms],slider_displacement [mm]\n" + "".join(f"{(k if k != 10 else 3) * 0.02},{k}\n" for k in range(30)),
      "does not increase"),
     ("NaN", "time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{'nan' if k == 5 else k}\n" for k in range(30)),
      "not a finite number"),
-    ("wrong unit", "time [ms],slider_displacement [deg]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(30)),
+    ("wrong unit", "time [ms],slider_displacement [deg]\n" + rows(30),
      "does not fit"),
-    ("too short to read", "time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(5)),
+    ("too short to read", "time [ms],slider_displacement [mm]\n" + rows(5),
      "at least"),
-    ("too short to diagnose", "time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(50)),
+    ("too short to diagnose", "time [ms],slider_displacement [mm]\n" + rows(50),
      "diagnosing needs at least"),
-    ("after the simulated window", "time [ms],slider_displacement [mm]\n" + "".join(f"{5000 + k * 0.02},{k % 17}\n" for k in range(1300)),
+    ("after the simulated window", "time [ms],slider_displacement [mm]\n" + rows(1300, start=5000, value=SAWTOOTH),
      "column 'time': the record spans 5000 ms to 5026 ms, the model 0 to 24 ms (solver.t_end): the record does not cover "
      "the simulated window; the time must be 0 at the trigger"),
-    ("time in ms written as s", "time [s],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k % 17}\n" for k in range(1300)),
+    ("time in ms written as s", "time [s],slider_displacement [mm]\n" + rows(1300, value=SAWTOOTH),
      "only 2 samples lie in the simulated window, too few to compare (at least 200); is the time in [s]? a time unit "
      "off by 1000"),
-    ("too short a stretch", "time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.001},{k % 17}\n" for k in range(1000)),
+    ("too short a stretch", "time [ms],slider_displacement [mm]\n" + rows(1000, step=0.001, value=SAWTOOTH),
      "the record covers 4.2% of the simulated window, too short to compare (at least 10%); record the whole motion, "
      "or lower solver.t_end"),
-    ("mostly after the motion", "time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k % 17}\n" for k in range(13000)),
+    ("mostly after the motion", "time [ms],slider_displacement [mm]\n" + rows(13000, value=SAWTOOTH),
      "only 9.2% of the record lies in the simulated window, the rest would be compared with a model at rest; "
      "raise solver.t_end"),
 ]
@@ -146,7 +154,7 @@ def test_bad_measured_data_is_one_message_and_exit_code_2(tmp_path, problem, con
 ])
 def test_bad_options_are_one_message_and_exit_code_2(tmp_path, options, message):
     record = tmp_path / "bench.csv"
-    record.write_text("time [ms],slider_displacement [mm]\n" + "".join(f"{k * 0.02},{k}\n" for k in range(300)))
+    record.write_text("time [ms],slider_displacement [mm]\n" + rows(300))
     (tmp_path / "notes.txt").write_text("not a folder")
     options = [option.format(tmp=tmp_path) for option in options]
     result = invoke("diagnose", SLIDER_CRANK, *IDEAL, "--measured", record, *options)

@@ -11,6 +11,7 @@ import copy
 import hashlib
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, Callable
 
 import h5py
 import numpy as np
@@ -62,28 +63,48 @@ class Evaluator:
             solver["output_rate"] = float(self.min_output_rate)
         return document_text(document)
 
-    def evaluate(self, documents: list[dict]) -> list[Prediction]:
-        """Predictions for the documents, in order; the new ones run in parallel."""
+    def evaluate(self, documents: list[dict], then: Callable[[int, Prediction], Any] | None = None) -> list:
+        """Predictions for the documents, in order; the new ones run in parallel.
+
+        then(i, prediction): what to return for document i instead of its prediction, computed as soon as that
+        prediction is there (a run reused at once, a new one when it ends): the parent's work on the finished runs
+        (reading their sensors, scoring them) overlaps the runs still going instead of following the batch.
+        """
+        then = then or (lambda _, prediction: prediction)
         texts = [self._prepared(copy.deepcopy(d)) for d in documents]
-        self.folder.mkdir(parents=True, exist_ok=True)
+        digests = [hashlib.sha256(text.encode()).hexdigest()[:16] for text in texts]
+        positions: dict[str, list[int]] = {}
+        for i, digest in enumerate(digests):
+            positions.setdefault(digest, []).append(i)
+        results: list = [None] * len(documents)
+
+        def finish(digest: str) -> None:
+            for i in positions[digest]:
+                results[i] = then(i, self._memory[digest])
+
         todo = {}
-        for text in texts:
-            digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-            if digest not in self._memory and digest not in todo:
-                todo[digest] = CaseTask(digest, text, self.config_name, str(self.base_dir), (),
-                                        str(self.folder / f"{digest}.h5"))
-        outcomes = {}
-        if todo:
-            interrupted = self.executor.run(run_case, list(todo.values()), lambda o: outcomes.__setitem__(o.name, o))
-            if interrupted:
-                raise KeyboardInterrupt
-        for digest, outcome in outcomes.items():
+        for digest, text in zip(digests, texts):
+            if digest in self._memory:
+                continue
+            todo.setdefault(digest, CaseTask(digest, text, self.config_name, str(self.base_dir), (),
+                                             str(self.folder / f"{digest}.h5")))
+        for digest in positions:
+            if digest not in todo:
+                finish(digest)
+
+        def collect(outcome) -> None:
             self.simulations += int(outcome.ran)
             if outcome.state == COMPLETE:
-                self._memory[digest] = Prediction(*_read_sensors(Path(todo[digest].output)))
+                self._memory[outcome.name] = Prediction(*_read_sensors(Path(todo[outcome.name].output)))
             else:
-                self._memory[digest] = Prediction(np.empty(0), {}, outcome.error or outcome.state)
-        return [self._memory[hashlib.sha256(t.encode()).hexdigest()[:16]] for t in texts]
+                self._memory[outcome.name] = Prediction(np.empty(0), {}, outcome.error or outcome.state)
+            finish(outcome.name)
+
+        if todo:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            if self.executor.run(run_case, list(todo.values()), collect):
+                raise KeyboardInterrupt
+        return results
 
 
 def _hertz(value) -> float:

@@ -130,10 +130,11 @@ class Scored:
 
 def evaluate_points(evaluator: Evaluator, record: Record, sensors: list[str],
                     jobs: list[tuple[Scored, float]], document: dict) -> None:
-    """Run candidate values (all at once, in parallel) and append the fitted points."""
-    predictions = evaluator.evaluate([scored.candidate.applied(document, value) for scored, value in jobs])
-    for (scored, value), prediction in zip(jobs, predictions):
-        scored.points.append(score_point(record, sensors, value, prediction))
+    """Run candidate values (all at once, in parallel) and append the fitted points (each scored as its run ends)."""
+    points = evaluator.evaluate([scored.candidate.applied(document, value) for scored, value in jobs],
+                                lambda i, prediction: score_point(record, sensors, jobs[i][1], prediction))
+    for (scored, _), point in zip(jobs, points):
+        scored.points.append(point)
 
 
 def score_point(record: Record, sensors: list[str], value: float, prediction: Prediction) -> Point:
@@ -467,8 +468,8 @@ def refit_jointly(evaluator: Evaluator, record: Record, sensors: list[str], docu
 def _run_joint(evaluator, record, sensors, document, joint: JointFit, units: list) -> None:
     known = {p.value for p in joint.points}
     new = [v for v in dict.fromkeys(joint.values(u) for u in units) if v not in known]
-    predictions = evaluator.evaluate([with_effects(document, joint.candidates, v) for v in new])
-    joint.points += [score_point(record, sensors, v, p) for v, p in zip(new, predictions)]
+    joint.points += evaluator.evaluate([with_effects(document, joint.candidates, v) for v in new],
+                                       lambda i, prediction: score_point(record, sensors, new[i], prediction))
 
 
 def stencil(centre: np.ndarray, step: float) -> list[np.ndarray]:

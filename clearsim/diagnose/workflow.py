@@ -254,8 +254,9 @@ def refitted(evaluator, record: Record, sensors: list[str], document: dict, effe
     before it (one parallel batch for those nested models), and its interval from the joint refit."""
     values = joint.best.value
     candidates = [e.candidate for e in effects]
-    nested = evaluator.evaluate([with_effects(document, candidates[:k], values[:k]) for k in range(1, len(effects))])
-    points = [score_point(record, sensors, values[:k], p) for k, p in enumerate(nested, start=1)] + [joint.best]
+    nested = evaluator.evaluate([with_effects(document, candidates[:k], values[:k]) for k in range(1, len(effects))],
+                                lambda i, prediction: score_point(record, sensors, values[:i + 1], prediction))
+    points = nested + [joint.best]
     failed = next((p for p in points if p.fit is None), None)
     if failed is not None:
         raise DiagnoseError(f"the model with the refitted effects {failed.value} does not run: {failed.error}")

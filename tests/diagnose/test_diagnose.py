@@ -163,6 +163,17 @@ def test_bad_options_are_one_message_and_exit_code_2(tmp_path, options, message)
     assert (tmp_path / "notes.txt").read_text() == "not a folder"
 
 
+def test_a_model_that_does_not_run_to_the_end_is_one_message_and_exit_code_2(tmp_path):
+    record = tmp_path / "bench.csv"
+    record.write_text("time [ms],slider_displacement [mm]\n" + rows(300))
+    # steps no shorter than 20 µs cannot resolve the first impact (0.23 ms): the solver stops the run there
+    result = invoke("diagnose", SLIDER_CRANK, "--set", "solver.min_step=2e-5", "--measured", record,
+                    "-o", tmp_path / "report")
+    assert result.exit_code == 2, result.output
+    text = " ".join(result.output.split())
+    assert "the model does not run to the end" in text and "fix it with `clearsim run` first" in text
+    assert "Traceback" not in result.output
+
 def test_candidate_documents_are_valid_mechanisms():
     """Every candidate of every kind writes a value that loads (no schema or reference error)."""
     from clearsim.diagnose.candidates import KINDS, candidates_for

@@ -37,6 +37,7 @@ than ln n_eff + SIGNIFICANCE to count as found: noise alone does not pass.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -151,17 +152,31 @@ def aligned_residuals(record: Record, prediction: Prediction, offset: float) -> 
     return residuals(record, predict(record, prediction.time, {s: prediction.sensors[s] for s in record.values}, offset))
 
 
-def screen(evaluator, record, sensors, candidates: list[Candidate], document, baseline: Point) -> list[Scored]:
+def screen(evaluator, record, sensors, candidates: list[Candidate], document,
+           check_model: Callable[[Prediction], None]) -> tuple[Point, list[Scored]]:
+    """The model as given and each candidate at the screening points, in one parallel batch, then the resonant
+    candidates' frequency-matched rounds; returns the model's point and the screened candidates. The model's run is
+    the batch's first, and check_model sees its prediction as soon as it ends: an error raised there stops the batch
+    (the screening runs do not wait for the model's, so no worker idles while it runs alone)."""
     scored = [Scored(c) for c in candidates]
-    evaluate_points(evaluator, record, sensors, [(s, v) for s in scored for v in s.candidate.from_unit(SCREEN_POINTS)],
-                    document)
+    jobs = [(s, v) for s in scored for v in s.candidate.from_unit(SCREEN_POINTS)]
+
+    def point(i: int, prediction: Prediction) -> Point:
+        if i == 0:
+            check_model(prediction)
+        return score_point(record, sensors, jobs[i - 1][1] if i else 0.0, prediction)
+
+    points = evaluator.evaluate([document] + [s.candidate.applied(document, v) for s, v in jobs], point)
+    for (s, _), screened in zip(jobs, points[1:]):
+        s.points.append(screened)
+    baseline = points[0]
     resonant = [s for s in scored if s.candidate.resonant]
     for _ in range(RESONANCE_ROUNDS if resonant else 0):
         latest = {id(s): len(s.points) for s in resonant}
         jobs = [(s, v) for s in resonant for v in resonance_seeds(record, baseline, s.points[-2:], s.candidate)]
         evaluate_points(evaluator, record, sensors, jobs, document)
         resonant = [s for s in resonant if len(s.points) > latest[id(s)]]
-    return scored
+    return baseline, scored
 
 
 def resonance_seeds(record: Record, baseline: Point, points: list[Point], candidate: Candidate) -> list[float]:

@@ -285,19 +285,20 @@ def _mechanism(document: dict, request: DiagnoseRequest):
 
 
 def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, request, number, say) -> Iteration:
-    base_prediction = evaluator.evaluate([document])[0]
-    if not base_prediction.ok:
-        raise DiagnoseError(f"{request.config}: the model does not run to the end ({base_prediction.error}); "
-                            "fix it with `clearsim run` first")
-    base_point = score_point(record, sensors, 0.0, base_prediction)
+    def check_model(prediction: Prediction) -> None:
+        if not prediction.ok:
+            raise DiagnoseError(f"{request.config}: the model does not run to the end ({prediction.error}); "
+                                "fix it with `clearsim run` first")
+
+    candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds, Path(request.config).parent) if c.key not in found_keys]
+    base_point, scored = screen(evaluator, record, sensors, candidates, document, check_model)
+    base_prediction = base_point.prediction
     baseline = base_point.fit
     aligned = predict(record, base_prediction.time, {s: base_prediction.sensors[s] for s in sensors}, baseline.offset)
     found_features = features(record, aligned, units)
     windows = disagreement_windows(record, residuals(record, aligned))
     say(f"iteration {number}: gap {baseline.gap:.3g} (trigger offset {baseline.offset * 1e3:.3f} ms), "
         f"{len(windows)} window(s) outside the noise band")
-    candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds, Path(request.config).parent) if c.key not in found_keys]
-    scored = screen(evaluator, record, sensors, candidates, document, base_point)
     visible = [s for s in scored if seen_by_sensors(s, baseline.chi_square)]
     chosen = to_fit(visible, base_point, record, request.fit_top)
     say(f"  screened {len(candidates)} candidates ({len(visible)} visible to the sensors); fitting "

@@ -1,10 +1,13 @@
-"""Benchmarks beside the timed cases: compile time on an empty numba cache, peak memory; `describe` prints
-each study's one-line summary. Each study takes (quick, folder, measurements, repeats), returns a JSON-ready dict.
+"""Benchmarks beside the timed cases: compile time on an empty numba cache, peak memory, a diagnosis's throughput;
+`describe` prints each study's one-line summary. Each study takes (quick, folder, measurements, repeats), returns a JSON-ready dict.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import os
+import shutil
+import statistics
 import subprocess
 import sys
 import textwrap
@@ -83,6 +86,48 @@ def memory(quick: bool, folder: Path, measurements, repeats: int = 1) -> dict:
     return {"t_end": t_end, "output_rate_hz": 1e4, "peak_rss_mb": megabytes, "wall_s": total}
 
 
+
+# --- a diagnosis: runs per minute, and whether it found what was hidden ------------------------------------
+
+DIAGNOSE_STUDY = {False: ("uhv-clearance-B", "B", 0.08e-3), True: ("crank-clearance", "slider_pin", 0.2e-3)}  # quick
+
+
+def _diagnose_studies():
+    """docs/scripts/diagnose_studies.py, the studies of docs/diagnose.md (one definition of each study)."""
+    path = ROOT / "docs" / "scripts" / "diagnose_studies.py"
+    spec = importlib.util.spec_from_file_location("diagnose_studies", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclasses look their module up while it loads
+    spec.loader.exec_module(module)
+    return module
+
+
+def diagnose_throughput(quick: bool, folder: Path, measurements, repeats: int = 1) -> dict:
+    """`clearsim diagnose` of a docs/diagnose.md study (a clearance hidden in a synthetic record; the uhv-clearance-B
+    study, with --quick the slider-crank's crank-clearance), each repeat in a new folder (no run file reused), on
+    the local pool (one worker per core): wall time of the command, the runs it made, runs per minute, and its
+    accuracy (the fitted clearance against the hidden one). At most 3 repeats: one is ~25 s."""
+    studies = _diagnose_studies()
+    name, joint, truth = DIAGNOSE_STUDY[quick]
+    study = next(s for s in studies.STUDIES if s.name == name)
+    found = []
+    for repeat in range(min(repeats, 3)):
+        root = folder / f"diagnose-{repeat}"
+        if repeat:  # the same record: synthesized once
+            (root / name).mkdir(parents=True)
+            shutil.copy(folder / "diagnose-0" / name / "bench.csv", root / name / "bench.csv")
+        found.append(studies.run_study(study, root))
+    walls = [f["wall_s"] for f in found]
+    effects = [{"kind": e["kind"], "target": e["target"], "value": next(iter(e["parameters"].values())),
+                "ties": e["ambiguous_with"]} for e in found[-1]["effects"]]
+    hit = next((e for e in effects if e["kind"] == "clearance" and e["target"] == joint), None)
+    runs = found[-1]["simulations"]
+    return {"study": name, "repeats": len(found), "runs": runs, "wall_median_s": statistics.median(walls),
+            "wall_min_s": min(walls), "wall_max_s": max(walls), "runs_per_minute": 60.0 * runs / statistics.median(walls),
+            "hidden": {"joint": joint, "clearance_m": truth}, "found": effects,
+            "error": abs(hit["value"] / truth - 1.0) if hit else None,
+            "gap_before": found[-1]["gap_before"], "gap_after": found[-1]["gap_after"]}
+
 def describe(name: str, result) -> str:
     if name == "profile":
         return "\n".join(f"profile {r['case']}: wall {r['wall_s']:.2f} s = integration {r['integration_share']:.0%}, "
@@ -95,6 +140,14 @@ def describe(name: str, result) -> str:
                 f"warm {result['warm_s']:.1f} s; with the compile-ahead helper){single}")
     if name == "memory":
         return f"peak memory (VmHWM), {result['t_end']} simulated at 10 kHz output: {result['peak_rss_mb']:.0f} MB"
+    if name == "diagnose":
+        named = ", ".join(f"{e['kind']} {e['target']} {e['value']:.4g}" for e in result["found"]) or "nothing"
+        hidden = result["hidden"]
+        found = (f"found {named} (hidden: clearance {hidden['joint']} {hidden['clearance_m']:.4g}"
+                 + (f", error {result['error']:.1%})" if result["error"] is not None else ", not named)"))
+        return (f"diagnose {result['study']}: {result['wall_median_s']:.1f} s [{result['wall_min_s']:.1f}, "
+                f"{result['wall_max_s']:.1f}] for {result['runs']} runs ({result['runs_per_minute']:.0f} runs/min); "
+                f"{found}; gap {result['gap_before']:.3g} → {result['gap_after']:.3g}")
     if name == "scaling":
         return "scaling (log–log slopes): " + ", ".join(f"{k} {v:.2f}" for k, v in result["orders"].items() if v is not None)
     return str(result)

@@ -113,9 +113,15 @@ def _scaling(document: dict) -> list[str]:
     return lines
 
 
+def _diagnose(document: dict) -> list[str]:
+    from benchmarks.extras import describe
+
+    return [f"- {describe('diagnose', document['diagnose'])}"] if document.get("diagnose") else []
+
+
 def render(document: dict) -> str:
     parts = [_cases(document), _side_by_side(document), _at_peer_accuracy(document), _ladders(document),
-             _cartesian_ladder(document), _scaling(document)]
+             _cartesian_ladder(document), _scaling(document), _diagnose(document)]
     return "\n\n".join("\n".join(p) for p in parts if p) + "\n"
 
 

@@ -93,3 +93,19 @@ def test_the_four_bar_chain_is_a_one_degree_of_freedom_mechanism_plus_its_cleara
         assert len(document["bodies"]) == 2 * bars + 1
         system = prepare(load_mechanism_text(four_bar_chain(bars, clearances)))
         assert system.degrees_of_freedom == 2 * clearances  # the crank is driven
+
+
+def test_the_diagnosis_benchmark_finds_the_hidden_clearance_and_counts_its_runs(tmp_path):
+    from benchmarks.extras import describe, diagnose_throughput
+
+    result = diagnose_throughput(quick=True, folder=tmp_path, measurements=[], repeats=1)
+    assert result["study"] == "crank-clearance" and result["repeats"] == 1 and result["runs"] > 0
+    assert result["wall_min_s"] == result["wall_median_s"] == result["wall_max_s"] > 0.0
+    assert result["runs_per_minute"] == pytest.approx(60.0 * result["runs"] / result["wall_median_s"])
+    (effect,) = result["found"]
+    assert effect["kind"] == "clearance"
+    assert "slider_pin" in {effect["target"], *[label.split("joint ")[-1] for label in effect["ties"]]}
+    if effect["target"] == "slider_pin":  # the crank pin's clearance fits as well (a tie the report names)
+        assert effect["value"] == pytest.approx(0.2e-3, rel=0.3) and result["error"] < 0.3
+        assert "found clearance slider_pin" in describe("diagnose", result)
+    assert result["gap_after"] < 0.6 * result["gap_before"]

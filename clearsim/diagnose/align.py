@@ -264,15 +264,21 @@ def fit_offset(record: Record, model_time: np.ndarray, model: dict[str, np.ndarr
 
 
 def scan_costs(record: Record, model_time: np.ndarray, model: dict[str, np.ndarray], offsets: np.ndarray) -> np.ndarray:
-    """χ² (D3) at each offset with the model filtered once, over the record's span widened by the offsets, and
-    then shifted: the comparison filter commutes with a shift but for its start-up at the window's ends, so
-    this finds the best offset's neighbourhood at a fraction of the cost of filtering every shifted copy."""
+    """χ² (D3) at each of `offsets`, a grid in steps of the record's sample step (fit_offset's scan), with the model
+    filtered once over the record's span widened by the offsets, and then shifted: the comparison filter commutes
+    with a shift but for its start-up at the window's ends, so this finds the best offset's neighbourhood at a
+    fraction of the cost of filtering every shifted copy. A shift by whole samples is a window of the filtered
+    model, so every offset's residual comes from one strided view, without interpolation."""
     step = 1.0 / record.rate
     widened = np.arange(record.time[0] - offsets.max() - step, record.time[-1] - offsets.min() + 1.5 * step, step)
-    filtered = {s: lowpass(np.interp(widened, model_time, model[s]), record.cutoff, record.rate) for s in record.values}
+    starts = np.rint((record.time[0] - offsets - widened[0]) / step).astype(int)  # the window of each offset
     weights = record.weights
-    return np.array([sum(weights[s] * np.sum((record.values[s] - np.interp(record.time - offset, widened, filtered[s])) ** 2)
-                         for s in record.values) for offset in offsets])
+    costs = np.zeros(len(offsets))
+    for s in record.values:
+        filtered = lowpass(np.interp(widened, model_time, model[s]), record.cutoff, record.rate)
+        windows = np.lib.stride_tricks.sliding_window_view(filtered, len(record.time))[starts]
+        costs += weights[s] * np.sum((record.values[s] - windows) ** 2, axis=1)
+    return costs
 
 
 def fit_at(record: Record, model_time: np.ndarray, model: dict[str, np.ndarray], offset: float) -> Fit:

@@ -12,6 +12,7 @@ the first stage stop the load; the later ones are gathered into one InputError.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -138,6 +139,10 @@ _SYNTAX_HINTS = {
 }
 MAX_NESTING = 50  # levels of mappings and lists; a mechanism file needs 5 (bodies → item → points → name → [x, y])
 MAX_VALUES = 100_000  # values once aliases are expanded; a large mechanism file has a few thousand
+# every mapping or list opens with one of these of its own ('- ', 'key:', '? key', '[', '{'), so a text with fewer
+# of them nests less deep than their count; libyaml composes 1000 levels safely (it crashes ~20 000 down)
+COLLECTION_INDICATORS = "-:?[{"
+COMPOSABLE_DEPTH = 1000
 
 
 def _syntax_problem(exc: yaml.YAMLError, source: str) -> Problem:
@@ -169,7 +174,11 @@ def nesting_problem(text: str) -> Problem | None:
     """Nesting deeper than MAX_NESTING, found in libyaml's events before its recursive composer meets it.
 
     (libyaml's composer overflows the C stack, a crash, some 20 000 levels down; Python code below recurses too.)
+    A text with fewer than COMPOSABLE_DEPTH collection indicators cannot nest that deep, and is not parsed twice:
+    its nesting beyond MAX_NESTING is found on the composed nodes (alias_problem), at the same place.
     """
+    if sum(text.count(indicator) for indicator in COLLECTION_INDICATORS) < COMPOSABLE_DEPTH:
+        return None
     depth = 0
     try:
         for event in yaml.parse(text, Loader=FAST_LOADER):
@@ -206,10 +215,10 @@ def alias_problem(root: Node | None) -> Problem | None:
             return Problem((), f"invalid YAML: the aliases (*name) expand the file to more than {MAX_VALUES} values",
                            "aliases repeat a block: use them for a few shared blocks, not nested in one another",
                            position=_position(node))
+        if isinstance(node, (SequenceNode, MappingNode)) and len(on_path) >= MAX_NESTING:
+            return _too_deep(_position(node))  # an empty list or mapping counts as a level, as in nesting_problem
         children = _children(node)
         if children:
-            if len(on_path) >= MAX_NESTING:
-                return _too_deep(_position(node))
             on_path.add(id(node))
             stack.append((node, True))
             stack.extend((child, False) for child in reversed(children))
@@ -340,8 +349,14 @@ class LoadedMechanism:
     mechanism: Mechanism
     path: Path
     source: SourceMap
-    resolved_yaml: str  # the YAML text after overrides: enough to reproduce the run
+    document: dict  # the YAML document after overrides, as parsed (not to be changed)
     base_dir: Path  # relative file names (CSV tables) are read from here
+
+    @cached_property
+    def resolved_yaml(self) -> str:
+        """The YAML text after overrides: enough to reproduce the run. Written when first asked for (a result
+        file's `config_yaml`): 1.4 ms that a run kept in memory does not need."""
+        return dump_yaml(self.document)
 
 
 def dump_yaml(document: dict) -> str:
@@ -418,5 +433,4 @@ def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[s
         problems += validation_problems(exc, document, Mechanism) + _references_of_valid_part(document, exc)
     if problems:
         raise InputError(problems, name, source)
-    resolved = dump_yaml(document)
-    return LoadedMechanism(mechanism, Path(name), source, resolved, base_dir or Path.cwd())
+    return LoadedMechanism(mechanism, Path(name), source, document, base_dir or Path.cwd())

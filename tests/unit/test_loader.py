@@ -217,6 +217,35 @@ def test_bad_file_gives_located_message(case):
     assert "Value error" not in message and "pydantic" not in message
 
 
+DEEP_TEXTS = {  # name: (text, deeper than MAX_NESTING = 50 levels)
+    "brackets-51": ("a: " + "[" * 50 + "]" * 50, True), "empty-mapping-51": ("a: " + "[" * 49 + "{}" + "]" * 49, True),
+    "flow-mappings": ("a: " + "{b: " * 60 + "1" + "}" * 60, True), "dashes": ("a:\n  " + "- " * 60 + "x\n", True),
+    "block-mappings": ("".join("  " * i + f"k{i}:\n" for i in range(51)) + "  " * 51 + "v: 1\n", True),
+    "brackets-50": ("a: " + "[" * 49 + "]" * 49, False), "empty-mapping-50": ("a: " + "[" * 48 + "{}" + "]" * 48, False)}
+
+
+@pytest.mark.parametrize("name", list(DEEP_TEXTS))
+def test_nesting_is_found_at_the_same_place_with_or_without_the_event_parse(name, monkeypatch):
+    """A short text skips libyaml's event parse (nesting_problem) and is checked on its composed nodes instead
+    (alias_problem): both must reject the same texts, at the same line and column."""
+    from clearsim.model import loader
+
+    text, too_deep = DEEP_TEXTS[name]
+
+    def outcome():
+        try:
+            load_mechanism_text(text, name="deep.yaml")
+        except InputError as exc:
+            return str(exc)
+        return "loaded"
+
+    skipped = outcome()
+    monkeypatch.setattr(loader, "COMPOSABLE_DEPTH", 0)
+    parsed = outcome()
+    assert skipped == parsed
+    assert ("nested more than 50 levels deep" in parsed) == too_deep, parsed
+
+
 def test_aliases_that_expand_beyond_reason_are_an_error_not_a_hang():
     levels = ["a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
     levels += [f"a{k}: &a{k} [" + ", ".join([f"*a{k - 1}"] * 10) + "]" for k in range(1, 5)]  # 10^5 values

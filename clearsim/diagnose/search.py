@@ -11,7 +11,9 @@ around its best point, never a gradient method:
     scan     six more values over the range for the most promising candidates (chosen by χ² in the
              comparison band and in the screening band, Record.low_band: frequency continuation)
     valley   three values about the minimum of the profile in the screening band, where a clearance's
-             cost is a smooth valley (in the comparison band it can be narrower than a scan step)
+             cost is a smooth valley (in the comparison band it can be narrower than a scan step), and the
+             midpoints between its lowest run there and that run's neighbours (the valley is within one step of
+             it, on a side the parabola can guess wrong)
     zoom     four, then two values between each of the two lowest local minima and their neighbours
     vertex   one value at the vertex of a parabola through the profile near its best point (the
              minimum with the chaotic scatter of single runs smoothed out)
@@ -319,15 +321,29 @@ def profile_vertex(scored: Scored, low_band: bool = False) -> float | None:
 
 
 def low_band_values(scored: Scored) -> list[float]:
-    """Values about the minimum of the candidate's profile in the screening band (its vertex and ± a quarter
-    of a scan step): where the valley of the comparison band lies when the scan missed it."""
+    """Values about the minimum of the candidate's profile in the screening band, where the valley of the comparison
+    band lies when the scan missed it: the profile's vertex and ± a quarter of a scan step, and the midpoints between
+    the lowest run there and its neighbours on either side (`bracket_midpoints`)."""
+    centres = []
     vertex = profile_vertex(scored, low_band=True)
-    if vertex is None:
-        return []
-    centre, quarter = float(scored.candidate.to_unit(vertex)), 0.25 / (SCAN_POINTS + 1)
+    if vertex is not None:
+        centre, quarter = float(scored.candidate.to_unit(vertex)), 0.25 / (SCAN_POINTS + 1)
+        centres = [centre - quarter, centre, centre + quarter]
     known = {p.value for p in scored.points}
-    values = [float(scored.candidate.from_unit(u)) for u in (centre - quarter, centre, centre + quarter) if 0.0 <= u <= 1.0]
-    return [v for v in values if v not in known]
+    values = [float(scored.candidate.from_unit(u)) for u in centres + bracket_midpoints(scored, True) if 0.0 <= u <= 1.0]
+    return [v for v in dict.fromkeys(values) if v not in known]
+
+
+def bracket_midpoints(scored: Scored, low_band: bool) -> list[float]:
+    """Midpoints (unit range) between the lowest run (in the comparison or the screening band) and its neighbours:
+    the minimum lies within one grid step of the lowest run, on a side that a parabola through the points guesses
+    wrong when the valley is skewed (steep on one side; the bundled UHV's clearance B, docs/diagnose.md)."""
+    points = sorted((p for p in scored.points if p.fit is not None), key=lambda p: p.value)
+    if len(points) < 2:
+        return []
+    units = scored.candidate.to_unit([p.value for p in points])
+    k = int(np.argmin([p.chi_square_in(low_band) for p in points]))
+    return [0.5 * (units[k] + units[j]) for j in (k - 1, k + 1) if 0 <= j < len(points)]
 
 
 def _zoom(scored: Scored, count: int) -> list[float]:

@@ -1,0 +1,46 @@
+"""The search's choice of values, on profiles given as numbers (no runs)."""
+
+import numpy as np
+import pytest
+
+from clearsim.diagnose.align import Fit
+from clearsim.diagnose.candidates import Candidate
+from clearsim.diagnose.evaluate import Prediction
+from clearsim.diagnose.search import Point, Scored, bracket_midpoints, low_band_values, profile_vertex
+
+# clearance B of the bundled UHV model, 2 µm … 0.5 mm on a log scale, as candidates_for makes it
+CLEARANCE_B = Candidate("clearance", "B", "clearance", "m", 2e-6, 5e-4, True, 5e-6, lambda document, value: None)
+
+# its screening and scan runs in the bundled-model study (clearance B 0.08 mm hidden, noise 1 %) on the machine of
+# sessions 8-11: value (m), χ² in the comparison band, χ² in the screening band
+BUNDLED_B_SCAN = [(4.4014e-06, 413.85, 114.63), (9.6863e-06, 410.46, 110.52), (1.0481e-05, 431.69, 111.45),
+                  (2.1317e-05, 420.24, 103.86), (4.6912e-05, 400.90, 92.17), (1.0324e-04, 615.14, 127.64),
+                  (1.2574e-04, 806.18, 111.30), (2.2720e-04, 1118.92, 199.31)]
+
+
+def _scored(candidate: Candidate, profile) -> Scored:
+    empty = Prediction(np.zeros(0), {})
+    return Scored(candidate, [Point(value, Fit(0.0, chi, {}, 1.0), empty, low_band=Fit(0.0, low, {}, 1.0))
+                              for value, chi, low in profile])
+
+
+def test_the_valley_step_brackets_the_lowest_run_of_the_screening_band():
+    """B's valley (runs at 55-90 µm: χ² 160-290, against 401 at 47 µm and 615 at 103 µm) lies between its lowest
+    screening-band run and the next scan value up. The parabola through the seven runs nearest the lowest puts the
+    vertex below 47 µm (the valley is steep on its far side), so the vertex's three values all missed it and every
+    later zoom followed the lower minima; the midpoint of that bracket does not."""
+    scored = _scored(CLEARANCE_B, BUNDLED_B_SCAN)
+    assert profile_vertex(scored, low_band=True) < 47e-6
+    values = low_band_values(scored)
+    inside = [v for v in values if 47e-6 < v < 103e-6]
+    assert len(inside) == 1 and inside[0] == pytest.approx(np.sqrt(4.6912e-05 * 1.0324e-04), rel=1e-4)
+    assert len(values) == len(set(values)) and not {v for v, _, _ in BUNDLED_B_SCAN} & set(values)
+
+
+def test_bracket_midpoints_lie_halfway_to_each_neighbour_in_the_unit_range():
+    linear = Candidate("drive", "d", "lag", "s", 0.0, 1.0, False, None, lambda document, value: None)
+    profile = [(0.1, 9.0, 5.0), (0.3, 4.0, 1.0), (0.7, 8.0, 3.0), (0.9, 1.0, 7.0)]
+    scored = _scored(linear, profile)
+    assert bracket_midpoints(scored, True) == pytest.approx([0.2, 0.5])  # lowest in the screening band: 0.3
+    assert bracket_midpoints(scored, False) == pytest.approx([0.8])  # lowest in the comparison band: the last run
+    assert bracket_midpoints(_scored(linear, profile[:1]), True) == []

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from benchmarks.suite import clearsim_ladder
+from benchmarks.suite import clearsim_ladder, paired_ratio
 from tests.support.slider_crank_minimal import FRICTION, FRICTIONLESS, Parameters, ideal_initial_state
 
 FLYWHEEL_INERTIA = 1e4  # kg m², the crank's inertia about its pivot: a prescribed constant speed in effect
@@ -222,7 +222,8 @@ def at_peer_accuracy(row: dict, ladder: list[dict]) -> dict:
 
 
 def compare_case(friction: bool, clearsim, repeats: int, quick: bool, folder) -> dict:
-    """Peer rows for one slider-crank case: the step ladder's errors, the matched step timed `repeats` times."""
+    """Peer rows for one slider-crank case: each step of the ladder run `repeats` times (wall median, min and max;
+    its errors, the same in every run), as clearsim's ladder is; the matched step timed `repeats` times more."""
     import statistics as stats
 
     t_end = clearsim.simulated_time_s
@@ -231,7 +232,9 @@ def compare_case(friction: bool, clearsim, repeats: int, quick: bool, folder) ->
     rows = []
     for step in STEP_LADDER[3:4] if quick else STEP_LADDER:
         result = simulate(friction, t_end, step)
-        rows.append({"step_s": step, "wall_s": result.wall_s, "steps": result.steps,
+        walls = [result.wall_s] + [simulate(friction, t_end, step).wall_s for _ in range(repeats - 1)]
+        rows.append({"step_s": step, "wall_s": stats.median(walls), "wall_min_s": min(walls), "wall_max_s": max(walls),
+                     "repeats": len(walls), "steps": result.steps,
                      "max_contact_force": result.max_contact_force, "peak_acceleration": result.peak_acceleration,
                      "crank_speed_drift": result.crank_speed_drift, **errors(result, tight)})
     matched = _matched(rows, clearsim.error_max_contact_force)
@@ -241,6 +244,10 @@ def compare_case(friction: bool, clearsim, repeats: int, quick: bool, folder) ->
            "clearsim_error_peak_acceleration": clearsim.error_peak_acceleration, "matched": matched}
     out["clearsim_ladder"] = ladder
     out["at_peer_accuracy"] = [at_peer_accuracy(row, ladder) for row in rows]
+    for row in out["at_peer_accuracy"]:  # the ratio again, from alternated pairs (equal outputs)
+        if row["clearsim"] is not None:
+            row["paired_ratio_in_memory"] = paired_ratio(lambda step=row["step_s"]: simulate(friction, t_end, step).wall_s,
+                                                         clearsim.case, row["clearsim"]["rtol"], repeats)
     if matched is None:
         return out
     walls = [simulate(friction, t_end, matched["step_s"]).wall_s for _ in range(repeats)]

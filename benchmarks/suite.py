@@ -18,6 +18,7 @@ import tempfile
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -210,6 +211,30 @@ def crank_study(compare_case, measurements: list[Measurement], repeats: int, qui
 CLEARSIM_LADDER = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7)  # rtol (atol = rtol/1000), loosest first
 
 
+def ladder_settings(case: Case, rtol: float) -> tuple[str, ...]:
+    """The case's overrides at one rung of CLEARSIM_LADDER (atol = rtol/1000)."""
+    return case.overrides + (f"solver.rtol={rtol!r}", f"solver.atol={rtol / 1000.0!r}")
+
+
+def paired_ratio(theirs: Callable[[], float], case_name: str, rtol: float, repeats: int) -> dict:
+    """Median and range of their wall over clearsim's (in memory, at rtol), one of each in turn, `repeats` pairs.
+
+    On a machine whose speed drifts from one minute to the next, the two sides measured in separate blocks (as the
+    ladders are) can each catch another phase; a pair runs both within a fraction of a second."""
+    case = next(c for c in CASES if c.name == case_name)
+    settings = ladder_settings(case, rtol)
+    ratios = []
+    for k in range(repeats):
+        if k % 2 == 0:
+            other = theirs()
+            mine = _run_in_memory(case.config, settings)[0]
+        else:
+            mine = _run_in_memory(case.config, settings)[0]
+            other = theirs()
+        ratios.append(other / mine)
+    return {"pairs": repeats, "median": statistics.median(ratios), "min": min(ratios), "max": max(ratios)}
+
+
 def clearsim_ladder(case_name: str, repeats: int, folder: Path) -> list[dict]:
     """The case at each rtol of CLEARSIM_LADDER: wall median and errors against the rtol/100 run of the default.
 
@@ -223,7 +248,7 @@ def clearsim_ladder(case_name: str, repeats: int, folder: Path) -> list[dict]:
     ref_peak, ref_force = _figures(_run(case.config, tight, folder, f"{case_name}-ladder-reference")[2])
     rows = []
     for rtol in CLEARSIM_LADDER:
-        settings = case.overrides + (f"solver.rtol={rtol!r}", f"solver.atol={rtol / 1000.0!r}")
+        settings = ladder_settings(case, rtol)
         try:
             runs = [_run(case.config, settings, folder, f"{case_name}-ladder-{rtol:g}-{k}") for k in range(repeats)]
         except RuntimeError as failure:  # a tolerance too loose for the contact: the row says so
@@ -357,7 +382,8 @@ def at_peer_accuracy(document: dict):
     study = document.get("peer") or {}
     out = Table(title="clearsim at the peer's accuracy: each Exudyn step vs the loosest clearsim rtol as accurate in both errors")
     for column in ("case", "Exudyn step", "Exudyn wall", "err acc. / F_n", "clearsim rtol", "clearsim wall",
-                   "err acc. / F_n", "Exudyn / clearsim", "clearsim in memory", "Exudyn / in memory"):
+                   "err acc. / F_n", "Exudyn / clearsim", "clearsim in memory", "Exudyn / in memory",
+                   "paired, in memory: median [min, max]"):
         out.add_column(column, justify="left" if column == "case" else "right")
     for case in study.get("cases", []):
         for row in case.get("at_peer_accuracy", []):
@@ -368,8 +394,13 @@ def at_peer_accuracy(document: dict):
                         f"{mine['error_peak_acceleration']:.1e} / {mine['error_max_contact_force']:.1e}" if mine else "",
                         f"{row['ratio']:.1f}×" if mine else "",
                         f"{mine['wall_in_memory_s']:.3f} s" if mine and "wall_in_memory_s" in mine else "",
-                        f"{row['ratio_in_memory']:.1f}×" if row.get("ratio_in_memory") else "")
+                        f"{row['ratio_in_memory']:.1f}×" if row.get("ratio_in_memory") else "",
+                        _paired_text(row.get("paired_ratio_in_memory")))
     return out
+
+
+def _paired_text(paired: dict | None) -> str:
+    return f"{paired['median']:.2f}× [{paired['min']:.2f}, {paired['max']:.2f}]" if paired else ""
 
 
 def _studies() -> dict:

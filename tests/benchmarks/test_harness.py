@@ -79,9 +79,13 @@ def test_the_peer_runs_or_says_how_to_install_it(document):
     assert first["exudyn"]["peak_normal_force"] == pytest.approx(first["minimal_model"]["peak_normal_force"], rel=1e-3)
     (case,) = peer["cases"]
     assert {"step_s", "error_max_contact_force", "error_peak_acceleration", "crank_speed_drift"} <= set(case["rows"][0])
+    for row in case["rows"]:  # each step timed as often as clearsim's ladder: a median, not one run
+        assert row["repeats"] == document["repeats"] and row["wall_min_s"] <= row["wall_s"] <= row["wall_max_s"]
     for row in case["at_peer_accuracy"]:  # each against clearsim's file run and its in-memory run (equal outputs)
         if row["clearsim"] is not None:
             assert row["ratio_in_memory"] == pytest.approx(row["wall_s"] / row["clearsim"]["wall_in_memory_s"])
+            paired = row["paired_ratio_in_memory"]  # and from alternated pairs
+            assert paired["pairs"] == document["repeats"] and 0.0 < paired["min"] <= paired["median"] <= paired["max"]
 
 
 def test_the_four_bar_chain_is_a_one_degree_of_freedom_mechanism_plus_its_clearance_joints():

@@ -223,15 +223,13 @@ def paired_ratio(theirs: Callable[[], float], case_name: str, rtol: float, repea
     ladders are) can each catch another phase; a pair runs both within a fraction of a second."""
     case = next(c for c in CASES if c.name == case_name)
     settings = ladder_settings(case, rtol)
+    def ours() -> float:
+        return _run_in_memory(case.config, settings)[0]
+
     ratios = []
     for k in range(repeats):
-        if k % 2 == 0:
-            other = theirs()
-            mine = _run_in_memory(case.config, settings)[0]
-        else:
-            mine = _run_in_memory(case.config, settings)[0]
-            other = theirs()
-        ratios.append(other / mine)
+        walls = {side: side() for side in ((theirs, ours) if k % 2 == 0 else (ours, theirs))}
+        ratios.append(walls[theirs] / walls[ours])
     return {"pairs": repeats, "median": statistics.median(ratios), "min": min(ratios), "max": max(ratios)}
 
 

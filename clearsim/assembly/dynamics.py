@@ -13,7 +13,7 @@ The state vector is y = [q, q̇, W], W the integrated powers (WORK_* below).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, types
 
 from clearsim.assembly.constraints import (
     constraint_count, evaluate_acceleration_rhs, evaluate_constraints, evaluate_jacobian_blocks, evaluate_velocity_rhs,
@@ -240,13 +240,28 @@ def generalized_forces(system, t, q, qd, modes, impact_speeds):
 
 
 @njit(cache=True)
-def rhs(system, t, y, modes, impact_speeds, ydot):
+def forces_and_accelerations(system, t, q, qd, modes, impact_speeds):
+    """(q̈, λ, applied power, damping loss, contact loss, friction loss) at (t, q, q̇): the model's dynamics, which
+    the loop's kernels call by address (their `dynamics` argument), so it is compiled once, not into each of them."""
+    generalized, applied, damping, contact, friction = generalized_forces(system, t, q, qd, modes, impact_speeds)
+    qdd, lam = accelerations(system, t, q, qd, generalized, modes)
+    return qdd, lam, applied, damping, contact, friction
+
+
+def dynamics_type(system_type):
+    """The numba type of a `dynamics` argument: forces_and_accelerations called by its address."""
+    vector, integers = types.float64[::1], types.int64[::1]
+    result = types.Tuple((vector, vector, types.float64, types.float64, types.float64, types.float64))
+    return types.FunctionType(result(system_type, types.float64, vector, vector, integers, vector))
+
+
+@njit(cache=True)
+def rhs(system, dynamics, t, y, modes, impact_speeds, ydot):
     """ẏ = f(t, y) for the current contact modes."""
     n = coordinate_count(system)
     q = y[:n]
     qd = y[n:2 * n]
-    generalized, applied, damping, contact, friction = generalized_forces(system, t, q, qd, modes, impact_speeds)
-    qdd, lam = accelerations(system, t, q, qd, generalized, modes)
+    qdd, lam, applied, damping, contact, friction = dynamics(system, t, q, qd, modes, impact_speeds)
     copy_into(ydot[:n], qd)
     copy_into(ydot[n:2 * n], qdd)
     ydot[2 * n + WORK_DRIVER] = driver_power(system, t, lam)

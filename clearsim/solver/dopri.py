@@ -47,7 +47,7 @@ def _accumulate(out, base, coefficients, h, stages, count):
 
 
 @njit(cache=True, inline="always")
-def step(system, t, y, f, h, modes, speeds, stages, y_new):
+def step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new):
     """One DOPRI5 step from (t, y) with ẏ(t) = f; fills stages (7, ny) and y_new; returns the error vector."""
     copy_into(stages[0], f)
     work = np.empty_like(y)
@@ -56,9 +56,9 @@ def step(system, t, y, f, h, modes, speeds, stages, y_new):
     end = np.nextafter(t + h, t)
     for s in range(1, 6):
         _accumulate(work, y, MATRIX[s], h, stages, s)
-        rhs(system, min(t + NODES[s] * h, end), work, modes, speeds, stages[s])
+        rhs(system, dynamics, min(t + NODES[s] * h, end), work, modes, speeds, stages[s])
     _accumulate(y_new, y, WEIGHTS, h, stages, WEIGHTS.shape[0])
-    rhs(system, end, y_new, modes, speeds, stages[6])
+    rhs(system, dynamics, end, y_new, modes, speeds, stages[6])
     error = np.zeros_like(y)
     _accumulate(error, error, ERROR_WEIGHTS, h, stages, ERROR_WEIGHTS.shape[0])
     return error

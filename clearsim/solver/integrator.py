@@ -24,19 +24,23 @@ places (events, mode switches, sampling, the step) are therefore inlined into `a
 `system` stay calls, since an inlined copy takes and releases a reference to each of its arrays.
 `switch_mode` stays a call too: it runs only at events, and inlined at its two places (`advance` and
 `consistent_modes`) its body was typed and lowered twice (1 s of compile time, session 7).
+The model's dynamics (forces and the constrained accelerations, the largest subtree) are called by address:
+`advance` takes `forces_and_accelerations` as its `dynamics` argument, typed as a function type (`compiled_loop`),
+and passes it to every kernel that needs q̈ or λ, so it is compiled once instead of into each of those libraries,
+and the loop's typing does not wait for it (session 12: −5 s of a cold compile in one process, results bitwise equal).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, typeof
 
 from clearsim.assembly.arrays import (
     CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_STIFFNESS, copy_into,
 )
 from clearsim.assembly.dynamics import (
-    accelerations, coordinate_count, effective_mass, generalized_forces, project_positions, project_velocities, rhs,
-    stick_row_index,
+    coordinate_count, dynamics_type, effective_mass, forces_and_accelerations, project_positions, project_velocities,
+    rhs, stick_row_index,
 )
 from clearsim.assembly.forces import (
     CONTACT, FREE, SLIDE_BACK, STICK, clearance_kinematics, contact_force_magnitudes, exact_stick,
@@ -82,13 +86,12 @@ def hysteresis(system, k):
 
 
 @njit(cache=True)
-def friction_reserve(system, t, y, modes, speeds, k):
+def friction_reserve(system, dynamics, t, y, modes, speeds, k):
     """(μ_s F_n − |F_t|, F_t) of sticking joint k: the friction force its stick constraint needs, and what is left."""
     n = coordinate_count(system)
     q = y[:n]
     qd = y[n:2 * n]
-    generalized = generalized_forces(system, t, q, qd, modes, speeds)[0]
-    friction = -accelerations(system, t, q, qd, generalized, modes)[1][stick_row_index(system, modes, k)]
+    friction = -dynamics(system, t, q, qd, modes, speeds)[1][stick_row_index(system, modes, k)]
     kin = clearance_kinematics(system, k, q, qd)
     normal = contact_force_magnitudes(system, k, kin[4], kin[5], kin[8], modes[k], speeds[k])[0]
     p = system.clearance_params[k]
@@ -96,7 +99,7 @@ def friction_reserve(system, t, y, modes, speeds, k):
 
 
 @njit(cache=True)
-def event_value(system, k, kind, t, y, modes, speeds):
+def event_value(system, dynamics, k, kind, t, y, modes, speeds):
     """(g, ġ) of joint k's event function; the event is g crossing 0 (ġ = 0: unknown).
 
     NORMAL: δ in free flight (onset at g ↑ 0), δ + ε in contact (loss at g ↓ 0).
@@ -112,7 +115,7 @@ def event_value(system, k, kind, t, y, modes, speeds):
     if mode == FREE or not exact_stick(system, k):
         return 1.0, 0.0
     if mode == STICK:
-        return friction_reserve(system, t, y, modes, speeds, k)[0], 0.0
+        return friction_reserve(system, dynamics, t, y, modes, speeds, k)[0], 0.0
     direction = -1.0 if mode == SLIDE_BACK else 1.0
     return direction * clearance_kinematics(system, k, y[:n], y[n:2 * n])[8] + SLIDE_HYSTERESIS, 0.0
 
@@ -125,18 +128,18 @@ def _crossed(mode, kind, before, after):
 
 
 @njit(cache=True)
-def _value_at(system, k, kind, t, y, stages, h, theta, modes, speeds, scratch):
+def _value_at(system, dynamics, k, kind, t, y, stages, h, theta, modes, speeds, scratch):
     interpolate(y, stages, h, theta, scratch)
-    return event_value(system, k, kind, t + theta * h, scratch, modes, speeds)
+    return event_value(system, dynamics, k, kind, t + theta * h, scratch, modes, speeds)
 
 
 @njit(cache=True, inline="always")
-def _extremum(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
+def _extremum(system, dynamics, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
     """θ where ġ = 0 between lo and hi (ġ changes sign there), by bisection (NORMAL events, which know ġ)."""
-    rate_lo = _value_at(system, k, kind, t, y, stages, h, lo, modes, speeds, scratch)[1]
+    rate_lo = _value_at(system, dynamics, k, kind, t, y, stages, h, lo, modes, speeds, scratch)[1]
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        rate = _value_at(system, k, kind, t, y, stages, h, mid, modes, speeds, scratch)[1]
+        rate = _value_at(system, dynamics, k, kind, t, y, stages, h, mid, modes, speeds, scratch)[1]
         if (rate > 0.0) == (rate_lo > 0.0):
             lo, rate_lo = mid, rate
         else:
@@ -147,18 +150,18 @@ def _extremum(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
 
 
 @njit(cache=True, inline="always")
-def _root(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
+def _root(system, dynamics, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
     """θ just past the crossing of g in [lo, hi] (Illinois false position on the dense output)."""
     mode = modes[k]
-    g_lo = _value_at(system, k, kind, t, y, stages, h, lo, modes, speeds, scratch)[0]
-    g_hi = _value_at(system, k, kind, t, y, stages, h, hi, modes, speeds, scratch)[0]
+    g_lo = _value_at(system, dynamics, k, kind, t, y, stages, h, lo, modes, speeds, scratch)[0]
+    g_hi = _value_at(system, dynamics, k, kind, t, y, stages, h, hi, modes, speeds, scratch)[0]
     side = 0
     for _ in range(100):
         if hi - lo <= 1e-13:
             break
         mid = (lo * g_hi - hi * g_lo) / (g_hi - g_lo) if g_hi != g_lo else 0.5 * (lo + hi)
         mid = min(max(mid, lo + 0.01 * (hi - lo)), hi - 0.01 * (hi - lo))
-        g_mid = _value_at(system, k, kind, t, y, stages, h, mid, modes, speeds, scratch)[0]
+        g_mid = _value_at(system, dynamics, k, kind, t, y, stages, h, mid, modes, speeds, scratch)[0]
         if _crossed(mode, kind, g_lo, g_mid):
             hi, g_hi = mid, g_mid
             if side == -1:
@@ -173,40 +176,40 @@ def _root(system, k, kind, t, y, stages, h, lo, hi, modes, speeds, scratch):
 
 
 @njit(cache=True, inline="always")
-def first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch):
+def first_event(system, dynamics, k, kind, t, y, y_new, stages, h, modes, speeds, scratch):
     """θ in (0, 1] of joint k's first event of this kind in the step, or 2.0 when there is none."""
     mode = modes[k]
     if kind == TANGENTIAL and (mode == FREE or not exact_stick(system, k)):
         return 2.0
-    g_prev, r_prev = event_value(system, k, kind, t, y, modes, speeds)
+    g_prev, r_prev = event_value(system, dynamics, k, kind, t, y, modes, speeds)
     theta_prev = 0.0
     for i in range(1, SUBDIVISIONS + 1):
         theta = i / SUBDIVISIONS
         if i == SUBDIVISIONS:
-            g, r = event_value(system, k, kind, t + h, y_new, modes, speeds)
+            g, r = event_value(system, dynamics, k, kind, t + h, y_new, modes, speeds)
         else:
-            g, r = _value_at(system, k, kind, t, y, stages, h, theta, modes, speeds, scratch)
+            g, r = _value_at(system, dynamics, k, kind, t, y, stages, h, theta, modes, speeds, scratch)
         if _crossed(mode, kind, g_prev, g):
-            return _root(system, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
+            return _root(system, dynamics, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
         turning = (r_prev > 0.0 and r < 0.0) if mode == FREE else (r_prev < 0.0 and r > 0.0)
         if kind == NORMAL and turning:  # a graze: δ may cross and return between the two samples
-            peak = _extremum(system, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
-            g_peak = _value_at(system, k, kind, t, y, stages, h, peak, modes, speeds, scratch)[0]
+            peak = _extremum(system, dynamics, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
+            g_peak = _value_at(system, dynamics, k, kind, t, y, stages, h, peak, modes, speeds, scratch)[0]
             if _crossed(mode, kind, g_prev, g_peak):
-                return _root(system, k, kind, t, y, stages, h, theta_prev, peak, modes, speeds, scratch)
+                return _root(system, dynamics, k, kind, t, y, stages, h, theta_prev, peak, modes, speeds, scratch)
         g_prev, r_prev, theta_prev = g, r, theta
     return 2.0
 
 
 @njit(cache=True, inline="always")
-def earliest_event(system, t, y, y_new, stages, h, modes, speeds, scratch):
+def earliest_event(system, dynamics, t, y, y_new, stages, h, modes, speeds, scratch):
     """(θ, joint, kind) of the step's first event, or (2.0, −1, NORMAL) when there is none."""
     event_theta = 2.0
     event_joint = np.int64(-1)  # int64 from the start: a literal would compile each callee once more for it
     event_kind = np.int64(NORMAL)
     for k in range(modes.shape[0]):
         for kind in range(2):
-            theta = first_event(system, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
+            theta = first_event(system, dynamics, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
             if theta < event_theta:
                 event_theta, event_joint, event_kind = theta, k, kind
     return event_theta, event_joint, event_kind
@@ -222,8 +225,8 @@ def project_state(system, t, y, modes):
 
 
 @njit(cache=True, inline="always")
-def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
-                 out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch):
+def emit_samples(system, dynamics, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints, out_t, out_y,
+                 out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch):
     """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives
     from them (derive_sample)."""
     dt = real[R_SAMPLE_DT]
@@ -242,8 +245,8 @@ def emit_samples(system, t, y, stages, h, t_next, modes, speeds, episode_of, rea
         copy_into(out_modes[row], modes)
         copy_into(out_speeds[row], speeds)
         copy_into(out_episode[row], episode_of)
-        derive_sample(system, sample_time, scratch, modes, speeds, out_qdd[row], out_lam[row], out_contact[row],
-                      out_energies[row])
+        derive_sample(system, dynamics, sample_time, scratch, modes, speeds, out_qdd[row], out_lam[row],
+                      out_contact[row], out_energies[row])
         ints[I_SAMPLES] += 1
         ints[I_NEXT_SAMPLE] += 1
 
@@ -263,7 +266,7 @@ def contact_time_step(system, k, q, modes, speed):
 
 
 @njit(cache=True, inline="always")
-def settle_friction(system, k, t, y, modes, speeds, may_stick):
+def settle_friction(system, dynamics, k, t, y, modes, speeds, may_stick):
     """Choose how joint k's contact carries friction at time t: slide on, or stick if the wall can hold it.
 
     Sliding faster than DECIDE_SPEED goes on in its direction. Slower (a reversal, or a new contact
@@ -281,7 +284,7 @@ def settle_friction(system, k, t, y, modes, speeds, may_stick):
         modes[k] = CONTACT if sliding > 0.0 else SLIDE_BACK
         return
     modes[k] = STICK
-    reserve, friction = friction_reserve(system, t, y, modes, speeds, k)
+    reserve, friction = friction_reserve(system, dynamics, t, y, modes, speeds, k)
     if reserve < 0.0 or not may_stick:
         modes[k] = SLIDE_BACK if friction > 0.0 else CONTACT
     else:
@@ -303,7 +306,7 @@ def tolerance_over_penetration(system, k, y, mass, speed, rtol, atol):
 
 
 @njit(cache=True)
-def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset, log_loss,
+def switch_mode(system, dynamics, k, kind, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset, log_loss,
                 log_speed, log_mass):
     """Apply joint k's event at time t; returns the suggested next step."""
     if kind == NORMAL and modes[k] != FREE:  # contact lost
@@ -316,7 +319,7 @@ def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, real, ints, lo
     if onset:
         speeds[k] = max(clearance_kinematics(system, k, y[:n], y[n:2 * n])[5], 0.0)
     # a stick that just broke slides; a new contact or a sliding one may stick
-    settle_friction(system, k, t, y, modes, speeds, modes[k] != STICK)
+    settle_friction(system, dynamics, k, t, y, modes, speeds, modes[k] != STICK)
     if not onset:
         ints[I_FRICTION_EVENTS] += 1
         return np.inf
@@ -342,7 +345,7 @@ def switch_mode(system, k, kind, t, y, modes, speeds, episode_of, real, ints, lo
 
 
 @njit(cache=True, inline="always")
-def consistent_modes(system, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset, log_loss,
+def consistent_modes(system, dynamics, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset, log_loss,
                      log_speed, log_mass):
     """Switch joints whose mode disagrees with the state at the step start (initial state, restarts)."""
     h = np.inf
@@ -350,10 +353,10 @@ def consistent_modes(system, t, y, modes, speeds, episode_of, real, ints, log_jo
         for kind in range(2):
             if kind == TANGENTIAL and (modes[k] == FREE or not exact_stick(system, k)):
                 continue
-            g = event_value(system, k, kind, t, y, modes, speeds)[0]
+            g = event_value(system, dynamics, k, kind, t, y, modes, speeds)[0]
             if g > 0.0 if (kind == NORMAL and modes[k] == FREE) else g < 0.0:
-                h = min(h, switch_mode(system, k, kind, t, y, modes, speeds, episode_of, real, ints, log_joint,
-                                       log_onset, log_loss, log_speed, log_mass))
+                h = min(h, switch_mode(system, dynamics, k, kind, t, y, modes, speeds, episode_of, real, ints,
+                                       log_joint, log_onset, log_loss, log_speed, log_mass))
     return h
 
 
@@ -419,7 +422,7 @@ def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
 
 
 @njit(cache=True, inline="always")
-def refine_event(system, k, kind, t, y, f, h_event, modes, speeds, stages, y_event, ints):
+def refine_event(system, dynamics, k, kind, t, y, f, h_event, modes, speeds, stages, y_event, ints):
     """Integrate from t exactly to joint k's event; returns the step length.
 
     NORMAL events: Newton on the step length until |δ| < 1e-3 ε. TANGENTIAL events: the dense-output
@@ -427,12 +430,12 @@ def refine_event(system, k, kind, t, y, f, h_event, modes, speeds, stages, y_eve
     """
     tolerance = 1e-3 * hysteresis(system, k)
     for _ in range(6):
-        step(system, t, y, f, h_event, modes, speeds, stages, y_event)
+        step(system, dynamics, t, y, f, h_event, modes, speeds, stages, y_event)
         ints[I_RHS] += 6
         project_state(system, t + h_event, y_event, modes)
         if kind == TANGENTIAL:
             break
-        g, rate = event_value(system, k, kind, t + h_event, y_event, modes, speeds)
+        g, rate = event_value(system, dynamics, k, kind, t + h_event, y_event, modes, speeds)
         if abs(g) <= tolerance or rate == 0.0:
             break
         h_event = min(max(h_event - g / rate, 0.5 * h_event), 2.0 * h_event)
@@ -440,7 +443,7 @@ def refine_event(system, k, kind, t, y, f, h_event, modes, speeds, stages, y_eve
 
 
 @njit(cache=True)
-def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_onset, log_loss,
+def advance(system, dynamics, y, f, real, ints, modes, speeds, episode_of, log_joint, log_onset, log_loss,
             log_speed, log_mass, peak_force, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam,
             out_contact, out_energies, t_stop):
     """Integrate until t_stop, the end, a full buffer, STEPS_PER_CALL tried steps or a failure; the status is
@@ -453,7 +456,7 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
     capacity = out_t.shape[0]
     attempts = 0
     if real[R_STEP] <= 0.0:
-        rhs(system, real[R_TIME], y, modes, speeds, f)
+        rhs(system, dynamics, real[R_TIME], y, modes, speeds, f)
         ints[I_STATUS] = FIRST_STEP
         return
     while True:
@@ -471,15 +474,15 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
         if ints[I_LOG] >= log_joint.shape[0] - modes.shape[0] - 1:
             ints[I_STATUS] = BUFFER_FULL
             return
-        switched = consistent_modes(system, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset,
+        switched = consistent_modes(system, dynamics, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset,
                                     log_loss, log_speed, log_mass)
         if switched < np.inf or ints[I_NEXT_SAMPLE] == 0:
-            rhs(system, t, y, modes, speeds, f)
+            rhs(system, dynamics, t, y, modes, speeds, f)
             ints[I_RHS] += 1
             real[R_STEP] = min(real[R_STEP], switched)
         if ints[I_NEXT_SAMPLE] == 0:  # the first sample, in the modes the initial state has
-            emit_samples(system, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
-                         out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
+            emit_samples(system, dynamics, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints, out_t, out_y,
+                         out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
         h = min(real[R_STEP], real[R_MAX_STEP], real[R_T_END] - t, free_flight_limit(system, y, modes))
         h = max(h, real[R_MIN_STEP])
         if capacity - ints[I_SAMPLES] < h / real[R_SAMPLE_DT] + 2.0:
@@ -487,7 +490,7 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
                 ints[I_STATUS] = BUFFER_FULL
                 return
             h = (capacity - 2) * real[R_SAMPLE_DT]
-        error = step(system, t, y, f, h, modes, speeds, stages, y_new)
+        error = step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new)
         ints[I_RHS] += 6
         norm = error_norm(error, y, y_new, 2 * n, real[R_RTOL], real[R_ATOL])
         if not np.isfinite(norm):
@@ -500,12 +503,13 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             real[R_STEP] = max(h * max(0.2, SAFETY * norm ** -0.2), real[R_MIN_STEP])
             continue
         real[R_STEP] = h * min(10.0, max(0.2, SAFETY * norm ** -0.2)) if norm > 0.0 else 10.0 * h
-        event_theta, event_joint, event_kind = earliest_event(system, t, y, y_new, stages, h, modes, speeds, scratch)
+        event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, modes, speeds,
+                                                              scratch)
         if event_joint >= 0:
-            h = refine_event(system, event_joint, event_kind, t, y, f, event_theta * h, modes, speeds, stages,
+            h = refine_event(system, dynamics, event_joint, event_kind, t, y, f, event_theta * h, modes, speeds, stages,
                              y_new, ints)
-        emit_samples(system, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints, out_t, out_y, out_modes,
-                     out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
+        emit_samples(system, dynamics, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints, out_t, out_y,
+                     out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
         if event_joint < 0:  # projected after the samples: the step end's factor then serves its rhs below
             violation = project_state(system, t + h, y_new, modes)
             real[R_VIOLATION] = max(real[R_VIOLATION], violation)
@@ -525,14 +529,34 @@ def advance(system, y, f, real, ints, modes, speeds, episode_of, log_joint, log_
             ints[I_STATUS] = NOT_FINITE
             return
         if event_joint >= 0:
-            suggested = switch_mode(system, event_joint, event_kind, real[R_TIME], y, modes, speeds, episode_of, real,
-                                    ints,
-                                    log_joint, log_onset, log_loss, log_speed, log_mass)
+            suggested = switch_mode(system, dynamics, event_joint, event_kind, real[R_TIME], y, modes, speeds,
+                                    episode_of, real, ints, log_joint, log_onset, log_loss, log_speed, log_mass)
             real[R_STEP] = min(real[R_STEP], suggested)
         for k in range(modes.shape[0]):
             if clearance_kinematics(system, k, y[:n], y[n:2 * n])[4] > DEEPEST_PENETRATION * system.clearance_params[k, CL_JOURNAL_RADIUS]:
                 ints[I_STATUS] = TOO_DEEP
                 ints[I_FAIL_JOINT] = k
                 return
-        rhs(system, real[R_TIME], y, modes, speeds, f)
+        rhs(system, dynamics, real[R_TIME], y, modes, speeds, f)
         ints[I_RHS] += 1
+
+
+def loop_arguments(system, *state):
+    """advance's arguments for a system's kernel arrays and the run's state arrays (and t_stop)."""
+    return (system, forces_and_accelerations, *state)
+
+
+def compiled_loop(arguments: tuple):
+    """`advance` for these arguments with its `dynamics` typed as an address (dynamics_type), compiled or loaded from
+    the cache at the first call in a process; then nothing else is compiled for it, so arguments of other types fail
+    instead of compiling a second loop that links the dynamics in."""
+    global _loop_ready
+    if not _loop_ready:
+        advance.compile(tuple(dynamics_type(typeof(arguments[0])) if value is forces_and_accelerations
+                              else typeof(value) for value in arguments))
+        advance.disable_compile()
+        _loop_ready = True
+    return advance
+
+
+_loop_ready = False

@@ -27,6 +27,7 @@ from numba import typeof, types
 from numba.core import config
 
 from clearsim.assembly.arrays import KernelArraysType, blas_hidden
+from clearsim.assembly.dynamics import dynamics_type
 from clearsim.solver.integrator import advance
 
 LOCK_NAME = "compile-ahead.lock"
@@ -34,18 +35,18 @@ DISABLE_VARIABLE = "CLEARSIM_COMPILE_AHEAD"
 
 F, I = types.float64, types.int64
 V, IV, M = types.float64[::1], types.int64[::1], types.float64[:, ::1]
+D = object()  # stands for dynamics_type(system_type()) in AHEAD
 
 # (module, kernel, argument types after the system): what the helper compiles, in this order. The run reaches
 # the right-hand side first (after the assembly's kernels and `advance`'s own early passes), so the helper starts
 # with the two halves of it and goes on with what the run needs later. This order measured best of those tried
 # (docs/performance.md); compiling `switch_mode` too (9 s with its subtree) made the run slower.
 AHEAD = (
-    ("clearsim.assembly.dynamics", "accelerations", (F, V, V, V, IV)),
-    ("clearsim.assembly.dynamics", "generalized_forces", (F, V, V, IV, V)),
-    ("clearsim.solver.integrator", "event_value", (I, I, F, V, IV, V)),
-    ("clearsim.solver.samples", "derive_sample", (F, V, IV, V, V, V, M, V)),
+    ("clearsim.assembly.dynamics", "forces_and_accelerations", D),
+    ("clearsim.solver.integrator", "event_value", (D, I, I, F, V, IV, V)),
+    ("clearsim.solver.samples", "derive_sample", (D, F, V, IV, V, V, V, M, V)),
     ("clearsim.solver.integrator", "project_state", (F, V, IV)),
-    ("clearsim.solver.integrator", "_value_at", (I, I, F, V, M, F, F, IV, V, V)),
+    ("clearsim.solver.integrator", "_value_at", (D, I, I, F, V, M, F, F, IV, V, V)),
     ("clearsim.solver.integrator", "normal_force_at", (I, V, M, F, F, IV, V, V)),
 )
 
@@ -76,9 +77,14 @@ def system_type():
 
 
 def kernels_ahead():
-    """(dispatcher, full signature) of each kernel of AHEAD, in order."""
+    """(dispatcher, full signature) of each kernel of AHEAD, in order. D stands for the `dynamics` argument's type
+    and, as a kernel's whole signature, for that type's signature with its return type, as numba compiles (and keys
+    in the cache) the kernel the loop calls by address."""
     system = system_type()
-    return [(getattr(importlib.import_module(module), name), (system, *arguments))
+    dynamics = dynamics_type(system)
+    return [(getattr(importlib.import_module(module), name),
+             dynamics.signature if arguments is D
+             else (system, *(dynamics if argument is D else argument for argument in arguments)))
             for module, name, arguments in AHEAD]
 
 

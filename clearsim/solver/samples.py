@@ -10,7 +10,7 @@ from numba import njit
 from clearsim.assembly.arrays import copy_into
 from clearsim.assembly.constraints import constraint_count
 from clearsim.assembly.dynamics import (
-    accelerations, constraint_violation, coordinate_count, generalized_forces, stick_row_index,
+    constraint_violation, coordinate_count, stick_row_index,
 )
 from clearsim.assembly.forces import STICK, clearance_kinematics, contact_force_magnitudes, potential_energy
 
@@ -22,16 +22,15 @@ ENERGY_FIELDS = 3
 
 
 @njit(cache=True)
-def derive_sample(system, t, state, modes, speeds, qdd, lam, contact, energies):
+def derive_sample(system, dynamics, t, state, modes, speeds, qdd, lam, contact, energies):
     """One sample's q̈ and λ into qdd and lam, its contact fields (nc, 7) into contact, and (kinetic, potential,
     violation) into energies."""
     n = coordinate_count(system)
     m = constraint_count(system)
     q = state[:n].copy()
     qd = state[n:2 * n].copy()
-    generalized = generalized_forces(system, t, q, qd, modes, speeds)[0]
-    accelerations_, multipliers = accelerations(system, t, q, qd, generalized, modes)
-    copy_into(qdd, accelerations_)
+    accelerations, multipliers = dynamics(system, t, q, qd, modes, speeds)[:2]
+    copy_into(qdd, accelerations)
     copy_into(lam, multipliers[:m])
     for k in range(system.clearance_bodies.shape[0]):
         ex, ey, _, _, penetration, rate, _, _, sliding = clearance_kinematics(system, k, q, qd)

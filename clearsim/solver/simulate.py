@@ -177,8 +177,9 @@ class Run:
 
     def _advance(self, t_stop: float) -> None:
         started = clock.perf_counter()
-        ig.advance(self.kernel_arrays, self.y, self.f, self.real, self.ints, self.modes, self.speeds,
-                   self.episode_of, *self.log, self.peak_force, *self.buffers, t_stop)
+        arguments = ig.loop_arguments(self.kernel_arrays, self.y, self.f, self.real, self.ints, self.modes, self.speeds,
+                                      self.episode_of, *self.log, self.peak_force, *self.buffers, t_stop)
+        ig.compiled_loop(arguments)(*arguments)
         if self.ints[ig.I_STATUS] == ig.FIRST_STEP:  # the first call: loads (or compiles) the loop, one rhs
             self.kernel_time += clock.perf_counter() - started
             precompile.reap_helper()

@@ -1,0 +1,56 @@
+"""The loop calls the model's dynamics by address (clearsim/solver/integrator.py `compiled_loop`, docs/performance.md
+*Compile time*, session 12): `advance` has one specialisation, whose `dynamics` argument is a function type, not the
+dispatcher's own type (which would link `forces_and_accelerations` into it and every kernel it passes it to), and it
+compiles nothing else, so arguments of another type fail at once."""
+
+import numpy as np
+import pytest
+from numba import types, typeof
+
+from clearsim.assembly.arrays import for_kernels
+from clearsim.assembly.dynamics import accelerations, dynamics_type, forces_and_accelerations, generalized_forces
+from clearsim.model.loader import load_mechanism
+from clearsim.runner import BUNDLED_CONFIG, prepare, simulate_config
+from clearsim.solver import integrator
+
+CRANK = BUNDLED_CONFIG.parent / "slider_crank_flores.yaml"
+
+
+def test_advance_has_one_specialisation_taking_the_dynamics_as_an_address(tmp_path):
+    simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")
+    (signature,) = integrator.advance.signatures
+    system = prepare(load_mechanism(CRANK, []))
+    assert signature[1] == dynamics_type(typeof(for_kernels(system.arrays)))
+    assert isinstance(signature[1], types.FunctionType)
+    assert signature[0] == typeof(for_kernels(system.arrays))
+
+
+def _values_of(signature_types):
+    """Zero-filled arguments of these numba types (arrays of their dtype and dimensions, zero scalars)."""
+    return [np.zeros((0,) * kind.ndim, dtype=kind.dtype.name) if isinstance(kind, types.Array) else 0.0
+            for kind in signature_types]
+
+
+def test_advance_refuses_arguments_of_another_type_instead_of_compiling_them(tmp_path):
+    simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")
+    (signature,) = integrator.advance.signatures
+    state = _values_of(signature[2:])
+    state[0] = state[0].astype(np.float32)  # y of another dtype
+    arguments = integrator.loop_arguments(for_kernels(prepare(load_mechanism(CRANK, [])).arrays), *state)
+    assert len(arguments) == len(signature)
+    with pytest.raises(TypeError):
+        integrator.compiled_loop(arguments)(*arguments)
+    assert integrator.advance.signatures == [signature]
+
+
+def test_the_dynamics_called_by_address_are_the_forces_and_accelerations():
+    system = prepare(load_mechanism(CRANK, []))
+    arrays = for_kernels(system.arrays)
+    modes = np.zeros(system.arrays.clearance_bodies.shape[0], dtype=np.int64)
+    speeds = np.zeros(modes.size)
+    qdd, lam, applied, damping, contact, friction = forces_and_accelerations(arrays, 0.0, system.q0, system.qd0,
+                                                                             modes, speeds)
+    generalized, *powers = generalized_forces(arrays, 0.0, system.q0, system.qd0, modes, speeds)
+    expected_qdd, expected_lam = accelerations(arrays, 0.0, system.q0, system.qd0, generalized, modes)
+    assert np.array_equal(qdd, expected_qdd) and np.array_equal(lam, expected_lam)
+    assert [applied, damping, contact, friction] == powers

@@ -33,7 +33,7 @@ and the loop's typing does not wait for it (session 12: −5 s of a cold compile
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, typeof
+from numba import njit, typeof, types
 
 from clearsim.assembly.arrays import (
     CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_STIFFNESS, copy_into,
@@ -224,9 +224,15 @@ def project_state(system, t, y, modes):
     return violation
 
 
+def projection_type(system_type):
+    """The numba type of a `projection` argument: project_state called by its address."""
+    return types.FunctionType(types.float64(system_type, types.float64, types.float64[::1], types.int64[::1]))
+
+
 @njit(cache=True, inline="always")
-def emit_samples(system, dynamics, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints, out_t, out_y,
-                 out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch):
+def emit_samples(system, dynamics, projection, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints,
+                 out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
+                 scratch):
     """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives
     from them (derive_sample)."""
     dt = real[R_SAMPLE_DT]
@@ -239,7 +245,7 @@ def emit_samples(system, dynamics, t, y, stages, h, t_next, modes, speeds, episo
             interpolate(y, stages, h, (sample_time - t) / h, scratch)
         else:
             copy_into(scratch, y)
-        project_state(system, sample_time, scratch, modes)
+        projection(system, sample_time, scratch, modes)
         out_t[row] = sample_time
         copy_into(out_y[row], scratch)
         copy_into(out_modes[row], modes)
@@ -266,7 +272,7 @@ def contact_time_step(system, k, q, modes, speed):
 
 
 @njit(cache=True, inline="always")
-def settle_friction(system, dynamics, k, t, y, modes, speeds, may_stick):
+def settle_friction(system, dynamics, projection, k, t, y, modes, speeds, may_stick):
     """Choose how joint k's contact carries friction at time t: slide on, or stick if the wall can hold it.
 
     Sliding faster than DECIDE_SPEED goes on in its direction. Slower (a reversal, or a new contact
@@ -288,7 +294,7 @@ def settle_friction(system, dynamics, k, t, y, modes, speeds, may_stick):
     if reserve < 0.0 or not may_stick:
         modes[k] = SLIDE_BACK if friction > 0.0 else CONTACT
     else:
-        project_state(system, t, y, modes)
+        projection(system, t, y, modes)
 
 
 @njit(cache=True, inline="always")
@@ -306,8 +312,8 @@ def tolerance_over_penetration(system, k, y, mass, speed, rtol, atol):
 
 
 @njit(cache=True)
-def switch_mode(system, dynamics, k, kind, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset, log_loss,
-                log_speed, log_mass):
+def switch_mode(system, dynamics, projection, k, kind, t, y, modes, speeds, episode_of, real, ints, log_joint,
+                log_onset, log_loss, log_speed, log_mass):
     """Apply joint k's event at time t; returns the suggested next step."""
     if kind == NORMAL and modes[k] != FREE:  # contact lost
         modes[k] = FREE
@@ -319,7 +325,7 @@ def switch_mode(system, dynamics, k, kind, t, y, modes, speeds, episode_of, real
     if onset:
         speeds[k] = max(clearance_kinematics(system, k, y[:n], y[n:2 * n])[5], 0.0)
     # a stick that just broke slides; a new contact or a sliding one may stick
-    settle_friction(system, dynamics, k, t, y, modes, speeds, modes[k] != STICK)
+    settle_friction(system, dynamics, projection, k, t, y, modes, speeds, modes[k] != STICK)
     if not onset:
         ints[I_FRICTION_EVENTS] += 1
         return np.inf
@@ -345,8 +351,8 @@ def switch_mode(system, dynamics, k, kind, t, y, modes, speeds, episode_of, real
 
 
 @njit(cache=True, inline="always")
-def consistent_modes(system, dynamics, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset, log_loss,
-                     log_speed, log_mass):
+def consistent_modes(system, dynamics, projection, t, y, modes, speeds, episode_of, real, ints, log_joint,
+                     log_onset, log_loss, log_speed, log_mass):
     """Switch joints whose mode disagrees with the state at the step start (initial state, restarts)."""
     h = np.inf
     for k in range(modes.shape[0]):
@@ -355,8 +361,8 @@ def consistent_modes(system, dynamics, t, y, modes, speeds, episode_of, real, in
                 continue
             g = event_value(system, dynamics, k, kind, t, y, modes, speeds)[0]
             if g > 0.0 if (kind == NORMAL and modes[k] == FREE) else g < 0.0:
-                h = min(h, switch_mode(system, dynamics, k, kind, t, y, modes, speeds, episode_of, real, ints,
-                                       log_joint, log_onset, log_loss, log_speed, log_mass))
+                h = min(h, switch_mode(system, dynamics, projection, k, kind, t, y, modes, speeds, episode_of, real,
+                                       ints, log_joint, log_onset, log_loss, log_speed, log_mass))
     return h
 
 
@@ -422,7 +428,7 @@ def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
 
 
 @njit(cache=True, inline="always")
-def refine_event(system, dynamics, k, kind, t, y, f, h_event, modes, speeds, stages, y_event, ints):
+def refine_event(system, dynamics, projection, k, kind, t, y, f, h_event, modes, speeds, stages, y_event, ints):
     """Integrate from t exactly to joint k's event; returns the step length.
 
     NORMAL events: Newton on the step length until |δ| < 1e-3 ε. TANGENTIAL events: the dense-output
@@ -432,7 +438,7 @@ def refine_event(system, dynamics, k, kind, t, y, f, h_event, modes, speeds, sta
     for _ in range(6):
         step(system, dynamics, t, y, f, h_event, modes, speeds, stages, y_event)
         ints[I_RHS] += 6
-        project_state(system, t + h_event, y_event, modes)
+        projection(system, t + h_event, y_event, modes)
         if kind == TANGENTIAL:
             break
         g, rate = event_value(system, dynamics, k, kind, t + h_event, y_event, modes, speeds)
@@ -443,7 +449,7 @@ def refine_event(system, dynamics, k, kind, t, y, f, h_event, modes, speeds, sta
 
 
 @njit(cache=True)
-def advance(system, dynamics, y, f, real, ints, modes, speeds, episode_of, log_joint, log_onset, log_loss,
+def advance(system, dynamics, projection, y, f, real, ints, modes, speeds, episode_of, log_joint, log_onset, log_loss,
             log_speed, log_mass, peak_force, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam,
             out_contact, out_energies, t_stop):
     """Integrate until t_stop, the end, a full buffer, STEPS_PER_CALL tried steps or a failure; the status is
@@ -474,15 +480,16 @@ def advance(system, dynamics, y, f, real, ints, modes, speeds, episode_of, log_j
         if ints[I_LOG] >= log_joint.shape[0] - modes.shape[0] - 1:
             ints[I_STATUS] = BUFFER_FULL
             return
-        switched = consistent_modes(system, dynamics, t, y, modes, speeds, episode_of, real, ints, log_joint, log_onset,
-                                    log_loss, log_speed, log_mass)
+        switched = consistent_modes(system, dynamics, projection, t, y, modes, speeds, episode_of, real, ints,
+                                    log_joint, log_onset, log_loss, log_speed, log_mass)
         if switched < np.inf or ints[I_NEXT_SAMPLE] == 0:
             rhs(system, dynamics, t, y, modes, speeds, f)
             ints[I_RHS] += 1
             real[R_STEP] = min(real[R_STEP], switched)
         if ints[I_NEXT_SAMPLE] == 0:  # the first sample, in the modes the initial state has
-            emit_samples(system, dynamics, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints, out_t, out_y,
-                         out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
+            emit_samples(system, dynamics, projection, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints,
+                         out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
+                         scratch)
         h = min(real[R_STEP], real[R_MAX_STEP], real[R_T_END] - t, free_flight_limit(system, y, modes))
         h = max(h, real[R_MIN_STEP])
         if capacity - ints[I_SAMPLES] < h / real[R_SAMPLE_DT] + 2.0:
@@ -506,12 +513,13 @@ def advance(system, dynamics, y, f, real, ints, modes, speeds, episode_of, log_j
         event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, modes, speeds,
                                                               scratch)
         if event_joint >= 0:
-            h = refine_event(system, dynamics, event_joint, event_kind, t, y, f, event_theta * h, modes, speeds, stages,
-                             y_new, ints)
-        emit_samples(system, dynamics, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints, out_t, out_y,
-                     out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, scratch)
+            h = refine_event(system, dynamics, projection, event_joint, event_kind, t, y, f, event_theta * h, modes,
+                             speeds, stages, y_new, ints)
+        emit_samples(system, dynamics, projection, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints,
+                     out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
+                     scratch)
         if event_joint < 0:  # projected after the samples: the step end's factor then serves its rhs below
-            violation = project_state(system, t + h, y_new, modes)
+            violation = projection(system, t + h, y_new, modes)
             real[R_VIOLATION] = max(real[R_VIOLATION], violation)
             if violation > DRIFT_LIMIT:
                 ints[I_STATUS] = DRIFT
@@ -529,8 +537,8 @@ def advance(system, dynamics, y, f, real, ints, modes, speeds, episode_of, log_j
             ints[I_STATUS] = NOT_FINITE
             return
         if event_joint >= 0:
-            suggested = switch_mode(system, dynamics, event_joint, event_kind, real[R_TIME], y, modes, speeds,
-                                    episode_of, real, ints, log_joint, log_onset, log_loss, log_speed, log_mass)
+            suggested = switch_mode(system, dynamics, projection, event_joint, event_kind, real[R_TIME], y, modes,
+                                    speeds, episode_of, real, ints, log_joint, log_onset, log_loss, log_speed, log_mass)
             real[R_STEP] = min(real[R_STEP], suggested)
         for k in range(modes.shape[0]):
             if clearance_kinematics(system, k, y[:n], y[n:2 * n])[4] > DEEPEST_PENETRATION * system.clearance_params[k, CL_JOURNAL_RADIUS]:
@@ -543,17 +551,18 @@ def advance(system, dynamics, y, f, real, ints, modes, speeds, episode_of, log_j
 
 def loop_arguments(system, *state):
     """advance's arguments for a system's kernel arrays and the run's state arrays (and t_stop)."""
-    return (system, forces_and_accelerations, *state)
+    return (system, forces_and_accelerations, project_state, *state)
 
 
 def compiled_loop(arguments: tuple):
-    """`advance` for these arguments with its `dynamics` typed as an address (dynamics_type), compiled or loaded from
-    the cache at the first call in a process; then nothing else is compiled for it, so arguments of other types fail
-    instead of compiling a second loop that links the dynamics in."""
+    """`advance` for these arguments with its `dynamics` and `projection` typed as addresses (dynamics_type,
+    projection_type), compiled or loaded from the cache at the first call in a process; then nothing else is
+    compiled for it, so arguments of other types fail instead of compiling a second loop that links them in."""
     global _loop_ready
     if not _loop_ready:
-        advance.compile(tuple(dynamics_type(typeof(arguments[0])) if value is forces_and_accelerations
-                              else typeof(value) for value in arguments))
+        system = typeof(arguments[0])
+        addressed = {id(forces_and_accelerations): dynamics_type(system), id(project_state): projection_type(system)}
+        advance.compile(tuple(addressed.get(id(value)) or typeof(value) for value in arguments))
         advance.disable_compile()
         _loop_ready = True
     return advance

@@ -28,26 +28,28 @@ from numba.core import config
 
 from clearsim.assembly.arrays import KernelArraysType, blas_hidden
 from clearsim.assembly.dynamics import dynamics_type
-from clearsim.solver.integrator import advance
+from clearsim.solver.integrator import advance, projection_type
 
 LOCK_NAME = "compile-ahead.lock"
 DISABLE_VARIABLE = "CLEARSIM_COMPILE_AHEAD"
 
 F, I = types.float64, types.int64
 V, IV, M = types.float64[::1], types.int64[::1], types.float64[:, ::1]
-D = object()  # stands for dynamics_type(system_type()) in AHEAD
+D, P = object(), object()  # stand for dynamics_type(system_type()) and projection_type(system_type()) in AHEAD
 
-# (module, kernel, argument types after the system): what the helper compiles, in this order. The run reaches
-# the right-hand side first (after the assembly's kernels and `advance`'s own early passes), so the helper starts
-# with the two halves of it and goes on with what the run needs later. This order measured best of those tried
-# (docs/performance.md); compiling `switch_mode` too (9 s with its subtree) made the run slower.
+# (module, kernel, argument types after the system): what the helper compiles, in this order. The run's typing of
+# `advance` reaches `switch_mode` first (~5 s after the assembly's kernels; `switch_mode` alone takes the helper
+# ~8 s from its start, with the factor kernels its effective mass needs), then the event function, the sampling and
+# the event search; it calls the kernels passed by address (the projection, the dynamics) only once `advance` is
+# compiled, so they come last. This order measured best (docs/performance.md, session 12).
 AHEAD = (
-    ("clearsim.assembly.dynamics", "forces_and_accelerations", D),
+    ("clearsim.solver.integrator", "switch_mode", (D, P, I, I, F, V, IV, V, IV, V, IV, IV, V, V, V, V)),
     ("clearsim.solver.integrator", "event_value", (D, I, I, F, V, IV, V)),
     ("clearsim.solver.samples", "derive_sample", (D, F, V, IV, V, V, V, M, V)),
-    ("clearsim.solver.integrator", "project_state", (F, V, IV)),
     ("clearsim.solver.integrator", "_value_at", (D, I, I, F, V, M, F, F, IV, V, V)),
     ("clearsim.solver.integrator", "normal_force_at", (I, V, M, F, F, IV, V, V)),
+    ("clearsim.solver.integrator", "project_state", P),
+    ("clearsim.assembly.dynamics", "forces_and_accelerations", D),
 )
 
 # dtype and dimensions of each field of KernelArrays, as build.pack and arrays._workspace make them
@@ -77,14 +79,14 @@ def system_type():
 
 
 def kernels_ahead():
-    """(dispatcher, full signature) of each kernel of AHEAD, in order. D stands for the `dynamics` argument's type
-    and, as a kernel's whole signature, for that type's signature with its return type, as numba compiles (and keys
-    in the cache) the kernel the loop calls by address."""
+    """(dispatcher, full signature) of each kernel of AHEAD, in order. D and P stand for the types of the arguments
+    the loop passes by address (`dynamics`, `projection`) and, as a kernel's whole signature, for that type's
+    signature with its return type, as numba compiles (and keys in the cache) a kernel called by address."""
     system = system_type()
-    dynamics = dynamics_type(system)
+    addressed = {D: dynamics_type(system), P: projection_type(system)}
     return [(getattr(importlib.import_module(module), name),
-             dynamics.signature if arguments is D
-             else (system, *(dynamics if argument is D else argument for argument in arguments)))
+             addressed[arguments].signature if arguments in addressed
+             else (system, *(addressed.get(argument, argument) for argument in arguments)))
             for module, name, arguments in AHEAD]
 
 

@@ -1,7 +1,8 @@
-"""The loop calls the model's dynamics by address (clearsim/solver/integrator.py `compiled_loop`, docs/performance.md
-*Compile time*, session 12): `advance` has one specialisation, whose `dynamics` argument is a function type, not the
-dispatcher's own type (which would link `forces_and_accelerations` into it and every kernel it passes it to), and it
-compiles nothing else, so arguments of another type fail at once."""
+"""The loop calls the model's dynamics and the projection by address (clearsim/solver/integrator.py `compiled_loop`,
+docs/performance.md *Compile time*, session 12): `advance` has one specialisation, whose `dynamics` and `projection`
+arguments are function types, not the dispatchers' own types (which would link `forces_and_accelerations` and
+`project_state` into it and into every kernel it passes them to), and it compiles nothing else, so arguments of
+another type fail at once."""
 
 import numpy as np
 import pytest
@@ -16,12 +17,13 @@ from clearsim.solver import integrator
 CRANK = BUNDLED_CONFIG.parent / "slider_crank_flores.yaml"
 
 
-def test_advance_has_one_specialisation_taking_the_dynamics_as_an_address(tmp_path):
+def test_advance_has_one_specialisation_taking_the_dynamics_and_the_projection_as_addresses(tmp_path):
     simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")
     (signature,) = integrator.advance.signatures
     system = prepare(load_mechanism(CRANK, []))
     assert signature[1] == dynamics_type(typeof(for_kernels(system.arrays)))
-    assert isinstance(signature[1], types.FunctionType)
+    assert signature[2] == integrator.projection_type(typeof(for_kernels(system.arrays)))
+    assert isinstance(signature[1], types.FunctionType) and isinstance(signature[2], types.FunctionType)
     assert signature[0] == typeof(for_kernels(system.arrays))
 
 
@@ -34,7 +36,7 @@ def _values_of(signature_types):
 def test_advance_refuses_arguments_of_another_type_instead_of_compiling_them(tmp_path):
     simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")
     (signature,) = integrator.advance.signatures
-    state = _values_of(signature[2:])
+    state = _values_of(signature[3:])
     state[0] = state[0].astype(np.float32)  # y of another dtype
     arguments = integrator.loop_arguments(for_kernels(prepare(load_mechanism(CRANK, [])).arrays), *state)
     assert len(arguments) == len(signature)

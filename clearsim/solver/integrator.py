@@ -18,16 +18,15 @@ Python (progress bar, writing, Ctrl-C); all its state lives in the arrays of `Ru
 at the top of the loop changes no result (tested with a return every 7 steps: every result file bitwise equal).
 
 Compile time (docs/performance.md): numba compiles every kernel it calls as a library of its own,
-with all its callees linked in and optimised again. The parts of the loop called at one or two
-places (events, mode switches, sampling, the step) are therefore inlined into `advance`
-(inline="always"), and so are the scalar helpers; kernels called many times per step that take
-`system` stay calls, since an inlined copy takes and releases a reference to each of its arrays.
-`switch_mode` stays a call too: it runs only at events, and inlined at its two places (`advance` and
-`consistent_modes`) its body was typed and lowered twice (1 s of compile time, session 7).
-The model's dynamics (forces and the constrained accelerations, the largest subtree) are called by address:
-`advance` takes `forces_and_accelerations` as its `dynamics` argument, typed as a function type (`compiled_loop`),
-and passes it to every kernel that needs q̈ or λ, so it is compiled once instead of into each of those libraries,
-and the loop's typing does not wait for it (session 12: −5 s of a cold compile in one process, results bitwise equal).
+with all its callees linked in and optimised again. So three kernels are called by address: `advance` takes
+the mode switch, the projection and the model's dynamics (forces and constrained accelerations) as arguments
+typed as function types (`addressed_kernels`, `compiled_loop`) and passes the projection and the dynamics on to
+the kernels that need them. Each is then compiled once, not into every library above it, and none has to be
+compiled before `advance` is typed, so on an empty cache a second process compiles them meanwhile
+(clearsim/solver/precompile.py). A call by address is not inlined (~4 % of the slider-crank's loop each for the
+dynamics and the projection), so the parts called every step (the event search, the sampling, the peak search,
+the DOPRI step) and the scalar helpers stay inlined by numba (inline="always"); kernels called many times per
+step stay ordinary calls, since an inlined copy takes and releases a reference to each of its arrays.
 """
 
 from __future__ import annotations
@@ -351,7 +350,7 @@ def switch_mode(system, dynamics, projection, k, kind, t, y, modes, speeds, epis
 
 
 @njit(cache=True, inline="always")
-def consistent_modes(system, dynamics, projection, t, y, modes, speeds, episode_of, real, ints, log_joint,
+def consistent_modes(system, dynamics, projection, mode_switch, t, y, modes, speeds, episode_of, real, ints, log_joint,
                      log_onset, log_loss, log_speed, log_mass):
     """Switch joints whose mode disagrees with the state at the step start (initial state, restarts)."""
     h = np.inf
@@ -361,7 +360,7 @@ def consistent_modes(system, dynamics, projection, t, y, modes, speeds, episode_
                 continue
             g = event_value(system, dynamics, k, kind, t, y, modes, speeds)[0]
             if g > 0.0 if (kind == NORMAL and modes[k] == FREE) else g < 0.0:
-                h = min(h, switch_mode(system, dynamics, projection, k, kind, t, y, modes, speeds, episode_of, real,
+                h = min(h, mode_switch(system, dynamics, projection, k, kind, t, y, modes, speeds, episode_of, real,
                                        ints, log_joint, log_onset, log_loss, log_speed, log_mass))
     return h
 
@@ -449,9 +448,9 @@ def refine_event(system, dynamics, projection, k, kind, t, y, f, h_event, modes,
 
 
 @njit(cache=True)
-def advance(system, dynamics, projection, y, f, real, ints, modes, speeds, episode_of, log_joint, log_onset, log_loss,
-            log_speed, log_mass, peak_force, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam,
-            out_contact, out_energies, t_stop):
+def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, speeds, episode_of, log_joint,
+            log_onset, log_loss, log_speed, log_mass, peak_force, out_t, out_y, out_modes, out_speeds, out_episode,
+            out_qdd, out_lam, out_contact, out_energies, t_stop):
     """Integrate until t_stop, the end, a full buffer, STEPS_PER_CALL tried steps or a failure; the status is
     ints[I_STATUS]."""
     n = coordinate_count(system)
@@ -480,8 +479,8 @@ def advance(system, dynamics, projection, y, f, real, ints, modes, speeds, episo
         if ints[I_LOG] >= log_joint.shape[0] - modes.shape[0] - 1:
             ints[I_STATUS] = BUFFER_FULL
             return
-        switched = consistent_modes(system, dynamics, projection, t, y, modes, speeds, episode_of, real, ints,
-                                    log_joint, log_onset, log_loss, log_speed, log_mass)
+        switched = consistent_modes(system, dynamics, projection, mode_switch, t, y, modes, speeds, episode_of, real,
+                                    ints, log_joint, log_onset, log_loss, log_speed, log_mass)
         if switched < np.inf or ints[I_NEXT_SAMPLE] == 0:
             rhs(system, dynamics, t, y, modes, speeds, f)
             ints[I_RHS] += 1
@@ -537,7 +536,7 @@ def advance(system, dynamics, projection, y, f, real, ints, modes, speeds, episo
             ints[I_STATUS] = NOT_FINITE
             return
         if event_joint >= 0:
-            suggested = switch_mode(system, dynamics, projection, event_joint, event_kind, real[R_TIME], y, modes,
+            suggested = mode_switch(system, dynamics, projection, event_joint, event_kind, real[R_TIME], y, modes,
                                     speeds, episode_of, real, ints, log_joint, log_onset, log_loss, log_speed, log_mass)
             real[R_STEP] = min(real[R_STEP], suggested)
         for k in range(modes.shape[0]):
@@ -549,19 +548,40 @@ def advance(system, dynamics, projection, y, f, real, ints, modes, speeds, episo
         ints[I_RHS] += 1
 
 
+# the kernels `advance` takes by address, in its argument order (addressed_kernels)
+ADDRESSED = (switch_mode, project_state, forces_and_accelerations)
+
+
+def addressed_kernels(system_type) -> list:
+    """(kernel, numba function type) of each kernel `advance` takes by address, in its argument order.
+
+    A kernel called by address is compiled once, as a library of its own, instead of being linked into (and
+    optimised again with) each library that calls it, and the caller's compilation does not wait for it. At the
+    loop's first call numba compiles or loads each one as it converts the argument, in this order; the compile-ahead
+    helper takes them in the reverse order (precompile.kernels_ahead), the largest first, so that on an empty cache
+    the two processes share them and meet in the middle."""
+    F, I, V, IV = types.float64, types.int64, types.float64[::1], types.int64[::1]
+    dynamics, projection = dynamics_type(system_type), projection_type(system_type)
+    signature = {
+        switch_mode: F(system_type, dynamics, projection, I, I, F, V, IV, V, IV, V, IV, IV, V, V, V, V),
+        project_state: projection.signature,
+        forces_and_accelerations: dynamics.signature,
+    }
+    return [(kernel, types.FunctionType(signature[kernel])) for kernel in ADDRESSED]
+
+
 def loop_arguments(system, *state):
     """advance's arguments for a system's kernel arrays and the run's state arrays (and t_stop)."""
-    return (system, forces_and_accelerations, project_state, *state)
+    return (system, *ADDRESSED, *state)
 
 
 def compiled_loop(arguments: tuple):
-    """`advance` for these arguments with its `dynamics` and `projection` typed as addresses (dynamics_type,
-    projection_type), compiled or loaded from the cache at the first call in a process; then nothing else is
+    """`advance` for these arguments with the kernels it takes by address typed as function types
+    (addressed_kernels), compiled or loaded from the cache at the first call in a process; then nothing else is
     compiled for it, so arguments of other types fail instead of compiling a second loop that links them in."""
     global _loop_ready
     if not _loop_ready:
-        system = typeof(arguments[0])
-        addressed = {id(forces_and_accelerations): dynamics_type(system), id(project_state): projection_type(system)}
+        addressed = {id(kernel): kind for kernel, kind in addressed_kernels(typeof(arguments[0]))}
         advance.compile(tuple(addressed.get(id(value)) or typeof(value) for value in arguments))
         advance.disable_compile()
         _loop_ready = True

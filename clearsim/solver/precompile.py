@@ -1,11 +1,13 @@
 """Compile ahead: on an empty kernel cache, a second process compiles part of the loop's kernels meanwhile.
 
-numba compiles in one thread per process, and a run's first call of `advance` compiles it with every kernel it
-calls (~19 s, docs/performance.md *Compile time*). When the cache holds no `advance`, the first run (`prepare`)
-starts `python -m clearsim.solver.precompile`, which compiles the kernels of `AHEAD` in that order into the same
-cache while the run compiles the assembly's kernels and starts on `advance`. When the run's compilation reaches
-a kernel the helper has already written, numba loads it from the cache instead of compiling it (the same
-machine code: the cache is keyed by the sources, and a cached kernel keeps the bitcode its callers link in).
+numba compiles in one thread per process. A run compiles the assembly's kernels, then `advance`, then, at the
+loop's first call, the kernels `advance` takes by address (integrator.addressed_kernels: the mode switch, the
+sampling, the event and peak searches, the projection, the dynamics), one after the other in its argument order.
+When the cache holds no `advance`, the first run (`prepare`) starts `python -m clearsim.solver.precompile`, which
+compiles into the same cache the event function (which the run's typing of `advance` needs early) and then the
+kernels taken by address in the reverse order, the largest first (`kernels_ahead`). When the run reaches a kernel
+the helper has already written, numba loads it from the cache instead of compiling it (the same machine code: the
+cache is keyed by the sources and the signature), so the two processes meet in the middle of that list.
 Nothing waits for the helper: a kernel both processes reach first is compiled by both, which costs CPU only.
 
 Only one helper runs per cache (a lock file), only with two or more cores, and never when the variable
@@ -28,28 +30,23 @@ from numba.core import config
 
 from clearsim.assembly.arrays import KernelArraysType, blas_hidden
 from clearsim.assembly.dynamics import dynamics_type
-from clearsim.solver.integrator import advance, projection_type
+from clearsim.solver.integrator import addressed_kernels, advance
 
 LOCK_NAME = "compile-ahead.lock"
 DISABLE_VARIABLE = "CLEARSIM_COMPILE_AHEAD"
 
 F, I = types.float64, types.int64
 V, IV, M = types.float64[::1], types.int64[::1], types.float64[:, ::1]
-D, P = object(), object()  # stand for dynamics_type(system_type()) and projection_type(system_type()) in AHEAD
+D = object()  # stands for dynamics_type(system_type()) in AHEAD
 
-# (module, kernel, argument types after the system): what the helper compiles, in this order. The run's typing of
-# `advance` reaches `switch_mode` first (~5 s after the assembly's kernels; `switch_mode` alone takes the helper
-# ~8 s from its start, with the factor kernels its effective mass needs), then the event function, the sampling and
-# the event search; it calls the kernels passed by address (the projection, the dynamics) only once `advance` is
-# compiled, so they come last. This order measured best (docs/performance.md, session 12).
+# (module, kernel, argument types after the system): what the helper compiles first, in this order: the kernels the
+# run's typing of `advance` reaches soon after the assembly's kernels (the event function, the sampling, the event
+# search, the peak search). Then come the kernels `advance` takes by address (kernels_ahead).
 AHEAD = (
-    ("clearsim.solver.integrator", "switch_mode", (D, P, I, I, F, V, IV, V, IV, V, IV, IV, V, V, V, V)),
     ("clearsim.solver.integrator", "event_value", (D, I, I, F, V, IV, V)),
     ("clearsim.solver.samples", "derive_sample", (D, F, V, IV, V, V, V, M, V)),
     ("clearsim.solver.integrator", "_value_at", (D, I, I, F, V, M, F, F, IV, V, V)),
     ("clearsim.solver.integrator", "normal_force_at", (I, V, M, F, F, IV, V, V)),
-    ("clearsim.solver.integrator", "project_state", P),
-    ("clearsim.assembly.dynamics", "forces_and_accelerations", D),
 )
 
 # dtype and dimensions of each field of KernelArrays, as build.pack and arrays._workspace make them
@@ -79,15 +76,16 @@ def system_type():
 
 
 def kernels_ahead():
-    """(dispatcher, full signature) of each kernel of AHEAD, in order. D and P stand for the types of the arguments
-    the loop passes by address (`dynamics`, `projection`) and, as a kernel's whole signature, for that type's
-    signature with its return type, as numba compiles (and keys in the cache) a kernel called by address."""
+    """(dispatcher, full signature) of each kernel the helper compiles, in order: those of AHEAD, then the kernels
+    `advance` takes by address in the reverse of the order in which the run's first call of the loop converts them
+    (so that the two processes meet in the middle), by their function types' signatures (numba compiles, and keys in
+    the cache, a kernel called by address by its signature with the return type)."""
     system = system_type()
-    addressed = {D: dynamics_type(system), P: projection_type(system)}
-    return [(getattr(importlib.import_module(module), name),
-             addressed[arguments].signature if arguments in addressed
-             else (system, *(addressed.get(argument, argument) for argument in arguments)))
-            for module, name, arguments in AHEAD]
+    dynamics = dynamics_type(system)
+    ahead = [(getattr(importlib.import_module(module), name),
+              (system, *(dynamics if argument is D else argument for argument in arguments)))
+             for module, name, arguments in AHEAD]
+    return ahead + [(kernel, kind.signature) for kernel, kind in reversed(addressed_kernels(system))]
 
 
 def cache_is_cold() -> bool:
@@ -136,7 +134,7 @@ def _stop_helper() -> None:
 
 
 def compile_ahead() -> list[str]:
-    """The helper's work: compile AHEAD into the cache, under the lock; returns the kernels compiled."""
+    """The helper's work: compile kernels_ahead() into the cache, under the lock; returns the kernels compiled."""
     import fcntl
 
     if not config.CACHE_DIR:

@@ -4,9 +4,9 @@
 numba types a constant argument (`True`, `-1`, `NORMAL`) as a literal and compiles the callee, with its whole
 subtree, once for each literal it sees; session 4 removed 23 such double compilations, and session 6 found one it had
 brought back itself (a `with_sticks` flag, ~1 s of compile time). On an empty kernel cache, the helper
-(`python -m clearsim.solver.precompile`) compiles the kernels of `AHEAD` first, as it does beside a first run; a run
-in a fresh process then compiles the rest (~20 s together) and is checked for kernels compiled twice, for kernels
-of AHEAD it compiled itself (the helper's signatures no longer match the run's), and for results that differ from a
+(`python -m clearsim.solver.precompile`) compiles its kernels (`kernels_ahead`) first, as it does beside a first run;
+a run in a fresh process then compiles the rest and is checked for kernels compiled twice, for kernels the helper
+wrote that it compiled itself (the helper's signatures no longer match the run's), and for results that differ from a
 run on the suite's own kernel cache.
 """
 
@@ -19,7 +19,7 @@ import h5py
 import numpy as np
 
 from clearsim.runner import BUNDLED_CONFIG, simulate_config
-from clearsim.solver.precompile import AHEAD, DISABLE_VARIABLE
+from clearsim.solver.precompile import DISABLE_VARIABLE, kernels_ahead
 
 ROOT = Path(__file__).resolve().parents[2]
 SCRIPT = """
@@ -60,7 +60,7 @@ def _compiled(env, *arguments) -> tuple[list[str], dict[str, int]]:
 
 def test_helper_then_run_compile_every_kernel_once_with_the_same_results(tmp_path):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "empty-cache"), **{DISABLE_VARIABLE: "0"})
-    ahead = [name for _, name, _ in AHEAD]
+    ahead = [kernel.py_func.__name__ for kernel, _ in kernels_ahead()]
     listed, by_helper = _compiled(env, "helper")
     assert listed == ahead
     _, by_run = _compiled(env, BUNDLED_CONFIG, tmp_path / "run.h5")

@@ -1,8 +1,8 @@
-"""The loop calls the model's dynamics and the projection by address (clearsim/solver/integrator.py `compiled_loop`,
-docs/performance.md *Compile time*, session 12): `advance` has one specialisation, whose `dynamics` and `projection`
-arguments are function types, not the dispatchers' own types (which would link `forces_and_accelerations` and
-`project_state` into it and into every kernel it passes them to), and it compiles nothing else, so arguments of
-another type fail at once."""
+"""The loop calls its larger kernels by address (clearsim/solver/integrator.py `addressed_kernels`, `compiled_loop`,
+docs/performance.md *Compile time*, session 12): `advance` has one specialisation, whose arguments for the dynamics,
+the projection, the mode switch, the sampling, the event search and the peak search are function types, not the
+dispatchers' own types (which would link those kernels into it and into every kernel it passes them to), and it
+compiles nothing else, so arguments of another type fail at once."""
 
 import numpy as np
 import pytest
@@ -17,14 +17,16 @@ from clearsim.solver import integrator
 CRANK = BUNDLED_CONFIG.parent / "slider_crank_flores.yaml"
 
 
-def test_advance_has_one_specialisation_taking_the_dynamics_and_the_projection_as_addresses(tmp_path):
+def test_advance_has_one_specialisation_taking_its_kernels_as_addresses(tmp_path):
     simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")
     (signature,) = integrator.advance.signatures
-    system = prepare(load_mechanism(CRANK, []))
-    assert signature[1] == dynamics_type(typeof(for_kernels(system.arrays)))
-    assert signature[2] == integrator.projection_type(typeof(for_kernels(system.arrays)))
-    assert isinstance(signature[1], types.FunctionType) and isinstance(signature[2], types.FunctionType)
-    assert signature[0] == typeof(for_kernels(system.arrays))
+    system_type = typeof(for_kernels(prepare(load_mechanism(CRANK, [])).arrays))
+    addressed = integrator.addressed_kernels(system_type)
+    assert signature[0] == system_type
+    assert {dynamics_type(system_type), integrator.projection_type(system_type)} <= set(signature)
+    assert list(signature[1:1 + len(addressed)]) == [kind for _, kind in addressed]
+    assert all(isinstance(kind, types.FunctionType) for kind in signature[1:1 + len(addressed)])
+    assert not any(isinstance(kind, types.FunctionType) for kind in signature[1 + len(addressed):])
 
 
 def _values_of(signature_types):
@@ -36,7 +38,7 @@ def _values_of(signature_types):
 def test_advance_refuses_arguments_of_another_type_instead_of_compiling_them(tmp_path):
     simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")
     (signature,) = integrator.advance.signatures
-    state = _values_of(signature[3:])
+    state = _values_of(signature[1 + len(integrator.addressed_kernels(signature[0])):])
     state[0] = state[0].astype(np.float32)  # y of another dtype
     arguments = integrator.loop_arguments(for_kernels(prepare(load_mechanism(CRANK, [])).arrays), *state)
     assert len(arguments) == len(signature)

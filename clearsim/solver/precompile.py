@@ -2,10 +2,10 @@
 
 numba compiles in one thread per process. A run compiles the assembly's kernels, then `advance`, then, at the
 loop's first call, the kernels `advance` takes by address (integrator.addressed_kernels: the mode switch, the
-sampling, the event and peak searches, the projection, the dynamics), one after the other in its argument order.
-When the cache holds no `advance`, the first run (`prepare`) starts `python -m clearsim.solver.precompile`, which
-compiles into the same cache the event function (which the run's typing of `advance` needs early) and then the
-kernels taken by address in the reverse order, the largest first (`kernels_ahead`). When the run reaches a kernel
+projection, the dynamics), one after the other in its argument order. When the cache holds no `advance`, the first
+run (`prepare`) starts `python -m clearsim.solver.precompile`, which compiles into the same cache the kernels the
+run's typing of `advance` needs early (`AHEAD`) and then those taken by address in the reverse order, the largest
+first (`kernels_ahead`). When the run reaches a kernel
 the helper has already written, numba loads it from the cache instead of compiling it (the same machine code: the
 cache is keyed by the sources and the signature), so the two processes meet in the middle of that list.
 Nothing waits for the helper: a kernel both processes reach first is compiled by both, which costs CPU only.

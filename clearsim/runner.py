@@ -19,7 +19,7 @@ from clearsim.assembly.system import System, assemble
 from clearsim.errors import ClearsimError, InputError, SolverError, format_path
 from clearsim.io.files import same_file
 from clearsim.io.hdf5 import (
-    ResultWriter, check_free_space, group_attribute, interrupts_deferred, keep_existing, read_result, write_failure,
+    ResultWriter, check_free_space, group_attribute, interrupts_deferred, keep_as_previous, read_result, write_failure,
 )
 from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
 from clearsim.solver.outputs import classify_episodes, chunk_outputs, sample_modes
@@ -113,7 +113,7 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     """
     output = Path(output)
     check_free_space(output, result_file_bytes(system))
-    backup = keep_existing(output)
+    backup = keep_as_previous(output)
     run = None  # made inside the try: loading the compiled kernels can take seconds, and may be interrupted
     episodes, status, complete, error = [], "complete", True, None
     # a state that overflows (absurd masses, speeds, forces) is reported once, by the solver's failure message,

@@ -14,7 +14,7 @@ from clearsim.diagnose.align import predict, residuals
 from clearsim.diagnose.evaluate import document_text
 from clearsim.diagnose.search import JointFit, Scored, smoothed_interval
 from clearsim.diagnose.workflow import Diagnosis, Effect, effect_line, found_effect, refit_line
-from clearsim.io.hdf5 import keep_existing
+from clearsim.io.hdf5 import keep_as_previous
 
 REPORT, JSON = "report.md", "diagnosis.json"
 
@@ -100,16 +100,16 @@ def write_report(d: Diagnosis, fmt: str = "png") -> list[Path]:
     folder.mkdir(parents=True, exist_ok=True)
     written = []
     json_path = folder / JSON
-    keep_existing(json_path)
+    keep_as_previous(json_path)
     json_path.write_text(json.dumps(diagnosis_document(d), indent=2, default=_plain) + "\n", encoding="utf-8")
     written.append(json_path)
     model_path = folder / f"{Path(d.request.config).stem}.diagnosed.yaml"
-    keep_existing(model_path)
+    keep_as_previous(model_path)
     model_path.write_text(augmented_yaml(d), encoding="utf-8")
     written.append(model_path)
     figures = _figures(d, fmt)
     report_path = folder / REPORT
-    keep_existing(report_path)
+    keep_as_previous(report_path)
     report_path.write_text(_markdown(d, figures, model_path), encoding="utf-8")
     written += [report_path, *figures]
     return written
@@ -216,7 +216,7 @@ def _figures(d: Diagnosis, fmt: str) -> list[Path]:
 def _save(fig, path: Path) -> Path:
     import matplotlib.pyplot as plt
 
-    keep_existing(path)
+    keep_as_previous(path)
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path

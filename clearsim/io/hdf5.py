@@ -26,22 +26,13 @@ from clearsim.errors import ClearsimError
 WRITE_HINT = "check that the folder exists and can be written, or choose another file with -o"
 
 
-def keep_existing(path: Path) -> Path | None:
-    """Rename an existing result to <stem>.<k><suffix> (first free k); return the new name."""
+def keep_as_previous(path: Path) -> Path | None:
+    """Rename an existing file (a result, a report, a figure) to <stem>.previous<suffix>, or the first free
+    <stem>.previous-<k><suffix> (k = 2, 3, …) when earlier ones exist: an older kept file is never overwritten, and
+    `clearsim plot` leaves these names out of a folder. Returns the new name (None: nothing was there)."""
     path = Path(path)
     if not path.exists():
         return None
-    k = 1
-    while (backup := path.with_name(f"{path.stem}.{k}{path.suffix}")).exists():
-        k += 1
-    path.rename(backup)
-    return backup
-
-
-def keep_as_previous(path: Path) -> Path:
-    """Rename a result to <stem>.previous<suffix>, or the first free <stem>.previous-<k><suffix> (k = 2, 3, …) when
-    earlier ones exist: an older kept result is never overwritten. Returns the new name."""
-    path = Path(path)
     backup, k = path.with_name(f"{path.stem}.previous{path.suffix}"), 2
     while backup.exists():
         backup, k = path.with_name(f"{path.stem}.previous-{k}{path.suffix}"), k + 1

@@ -66,7 +66,7 @@ def test_rerun_keeps_the_earlier_result(tmp_path):
     for _ in range(2):
         result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=1ms")
         assert result.exit_code == 0, result.output
-    assert "kept the earlier result as" in result.output and (tmp_path / "sc.1.h5").exists()
+    assert "kept the earlier result as" in result.output and (tmp_path / "sc.previous.h5").exists()
 
 
 def test_override_makes_the_clearance_joint_ideal(tmp_path):

@@ -87,7 +87,7 @@ def test_an_existing_report_is_kept(hidden_clearance, tmp_path):
     result = invoke("diagnose", SLIDER_CRANK, *IDEAL, "--measured", folder / "bench.csv", "-o", report,
                     "--candidates", "clearance", "--fit-top", "1")
     assert result.exit_code == 0, result.output
-    assert (report / "diagnosis.1.json").read_text() == before  # the earlier one, renamed
+    assert (report / "diagnosis.previous.json").read_text() == before  # the earlier one, renamed
 
 
 def rows(count: int, step: float = 0.02, start: float = 0, value=lambda k: k) -> str:

@@ -77,14 +77,15 @@ def test_solver_failure_keeps_samples_and_names_time_and_joint(tmp_path):
     assert 0.0 < result["time"][-1] < 0.003  # everything up to the failure is there
 
 
-def test_an_existing_result_is_kept_as_a_numbered_backup(tmp_path):
+def test_an_existing_result_is_kept_as_previous_and_never_overwritten(tmp_path):
     first, _ = run(tmp_path)
     created = read_result(first.output)["attrs"]["created"]
     second, _ = run(tmp_path)
-    assert second.backup == tmp_path / "sc.1.h5"
+    assert second.backup == tmp_path / "sc.previous.h5"
     assert read_result(second.backup)["attrs"]["created"] == created
     third, _ = run(tmp_path)
-    assert third.backup == tmp_path / "sc.2.h5"
+    assert third.backup == tmp_path / "sc.previous-2.h5"
+    assert read_result(second.backup)["attrs"]["created"] == created  # the older kept result is still there
 
 
 def test_a_selective_read_and_the_summary_agree_with_the_whole_file(tmp_path):

@@ -27,6 +27,10 @@ from clearsim.solver.simulate import Chunk, Run, Statistics
 from clearsim.solver import precompile
 
 BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
+# which per-sample histories a result file holds (its `contents` attribute, absent for "all"): every dataset of
+# DESIGN.md §6, or the sensors alone — a diagnosis reads nothing else of its model runs (a UHV run at 100 kHz: 13.4 → 0.63 MB).
+# The contact modes' episode tables and the run's attributes are in both.
+CONTENTS = {"all": lambda name: True, "sensors": lambda name: name.startswith("sensors/")}
 DEFAULT_OUTPUT = Path("results") / "run.h5"
 RESULT_SUFFIXES = (".h5", ".hdf5", ".hdf")
 
@@ -37,7 +41,7 @@ class OutputPathError(ClearsimError):
 
 def check_output_path(output: Path, config: Path) -> None:
     """Refuse, before anything runs, an output that would move a folder or the config aside, or put HDF5 in a
-    file named as something else (an existing file there is renamed to <stem>.1<suffix>, not overwritten)."""
+    file named as something else (an existing file there is renamed to <stem>.previous<suffix>, not overwritten)."""
     output = Path(output)
     hint = "hint: give a result file such as -o results/run.h5"
     if output.is_dir():
@@ -104,8 +108,9 @@ def _write_episodes(writer: ResultWriter, system: System, run: Run, sample_episo
 
 
 def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
-                progress: Callable[[float], None] | None = None) -> RunReport:
-    """Simulate and write as it goes; interruption or failure still leaves a flagged, readable file.
+                progress: Callable[[float], None] | None = None, contents: str = "all") -> RunReport:
+    """Simulate and write as it goes; interruption or failure still leaves a flagged, readable file with the
+    histories `contents` names (CONTENTS).
 
     Chunks are gathered and written at most every FLUSH_SECONDS of wall time (each HDF5 append
     costs ~0.4 ms per dataset, which for short runs cost more than the integration); whatever was
@@ -118,8 +123,9 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     episodes, status, complete, error = [], "complete", True, None
     # a state that overflows (absurd masses, speeds, forces) is reported once, by the solver's failure message,
     # not also by numpy's warnings from every place its samples pass through
-    with np.errstate(all="ignore"), ResultWriter(output, loaded.resolved_yaml, _attributes(system, loaded)) as writer:
-        pending = _PendingChunks(writer, episodes, system)
+    attributes = _attributes(system, loaded) | ({} if contents == "all" else {"contents": contents})
+    with np.errstate(all="ignore"), ResultWriter(output, loaded.resolved_yaml, attributes) as writer:
+        pending = _PendingChunks(writer, episodes, system, CONTENTS[contents])
         try:
             run = Run(system)
             for chunk in run.chunks(progress):
@@ -177,8 +183,8 @@ class _PendingChunks:
     episodes (once per flush, not per chunk: the per-call cost of deriving ~40 datasets was a fifth of a short
     run's wall time). The contact modes written here are provisional; the final ones replace them at the end."""
 
-    def __init__(self, writer: ResultWriter, episodes: list, system: System):
-        self.writer, self.episodes, self.system = writer, episodes, system
+    def __init__(self, writer: ResultWriter, episodes: list, system: System, wanted: Callable[[str], bool]):
+        self.writer, self.episodes, self.system, self.wanted = writer, episodes, system, wanted
         self.run: Run | None = None
         self.items: list = []
         self.initial_energy: float | None = None
@@ -197,7 +203,8 @@ class _PendingChunks:
             return
         chunk = Chunk.joined(self.items)
         provisional = sample_modes(classify_episodes(self.system, self.run.episode_log()), chunk.episodes)
-        outputs = chunk_outputs(self.system, chunk, provisional, self.initial_energy)
+        outputs = {name: values for name, values in chunk_outputs(self.system, chunk, provisional,
+                                                                   self.initial_energy).items() if self.wanted(name)}
         with interrupts_deferred():  # the samples and their episodes are written whole, or not at all
             self.writer.append(chunk.times, outputs)
             self.episodes.append(chunk.episodes)

@@ -87,7 +87,7 @@ class Evaluator:
             if digest in self._memory:
                 continue
             todo.setdefault(digest, CaseTask(digest, text, self.config_name, str(self.base_dir), (),
-                                             str(self.folder / f"{digest}.h5")))
+                                             str(self.folder / f"{digest}.h5"), contents="sensors"))
         for digest in positions:
             if digest not in todo:
                 finish(digest)

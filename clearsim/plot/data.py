@@ -62,9 +62,14 @@ class RunData:
         return key in self.datasets
 
     def require(self, key: str, purpose: str) -> None:
-        if key not in self.datasets:
-            raise PlotInputError(f"{self.path}: no dataset /{key} (needed for {purpose}); "
-                                 "the file may come from an interrupted run or an older clearsim")
+        if key in self.datasets:
+            return
+        if self.attrs.get("contents") == "sensors":
+            raise PlotInputError(f"{self.path}: holds the time and the sensors alone (a diagnosis's model run), no "
+                                 f"/{key} for {purpose}; run its mechanism with `clearsim run` for every history "
+                                 "(the file's config_yaml attribute is the mechanism)")
+        raise PlotInputError(f"{self.path}: no dataset /{key} (needed for {purpose}); "
+                             "the file may come from an interrupted run or an older clearsim")
 
     def series(self, key: str, purpose: str = "this figure") -> np.ndarray:
         """A per-sample dataset restricted to the time window."""

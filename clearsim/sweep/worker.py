@@ -36,6 +36,7 @@ class CaseTask:
     overrides: tuple[str, ...]
     output: str
     retry_failed: bool = False
+    contents: str = "all"  # the histories its file holds (runner.CONTENTS): a diagnosis asks for the sensors alone
 
 
 @dataclass
@@ -107,10 +108,10 @@ def _attempt(task: CaseTask) -> CaseOutcome:
     loaded = load_mechanism_text(task.config_text, task.config_name, task.overrides, Path(task.base_dir))
     output = Path(task.output)
     output_sensors = loaded.mechanism.output
-    if _reusable(output, loaded.resolved_yaml, task.retry_failed):
+    if _reusable(output, loaded.resolved_yaml, task.retry_failed, task.contents):
         return _outcome(task.name, output, output_sensors, ran=False)
     system = prepare(loaded)
-    report = run_to_file(system, loaded, output)
+    report = run_to_file(system, loaded, output, contents=task.contents)
     if isinstance(report.error, KeyboardInterrupt):
         raise KeyboardInterrupt
     if isinstance(report.error, ResultWriteError):
@@ -131,7 +132,7 @@ def finished_outcome(task: CaseTask) -> CaseOutcome | None:
         if not output.exists():
             return None
         attrs = read_result(output)["attrs"]
-        if attrs.get("complete") and attrs.get("config_yaml") == loaded.resolved_yaml:
+        if attrs.get("complete") and _same_case(attrs, loaded.resolved_yaml, task.contents):
             return _outcome(task.name, output, loaded.mechanism.output, ran=True)
     except (ClearsimError, NotAResultFile, OSError):
         pass
@@ -146,7 +147,13 @@ def _outcome(name: str, output: Path, output_sensors, ran: bool) -> CaseOutcome:
     return CaseOutcome(name, FAILED, ran, error, record)
 
 
-def _reusable(output: Path, resolved_yaml: str, retry_failed: bool) -> bool:
+def _same_case(attrs, resolved_yaml: str, contents: str) -> bool:
+    """A file written from this YAML that holds what the case asks for (a full file serves any case)."""
+    held = str(attrs.get("contents", "all"))
+    return attrs.get("config_yaml") == resolved_yaml and held in ("all", contents)
+
+
+def _reusable(output: Path, resolved_yaml: str, retry_failed: bool, contents: str = "all") -> bool:
     """Whether an existing file is this case's result; an unusable one is cleared away."""
     if not output.exists():
         return False
@@ -155,12 +162,12 @@ def _reusable(output: Path, resolved_yaml: str, retry_failed: bool) -> bool:
     except (NotAResultFile, OSError):
         output.unlink()  # a file cut short by a hard kill
         return False
-    same = attrs.get("config_yaml") == resolved_yaml
+    same = _same_case(attrs, resolved_yaml, contents)
     status = str(attrs.get("status", ""))
     if same and (bool(attrs.get("complete")) or (status.startswith("failed") and not retry_failed)):
         return True
     if same:
         output.unlink()  # interrupted, or failed and retried: this case's own file, nothing worth keeping
     else:
-        keep_as_previous(output)  # written from another YAML: kept, never over an older kept one
+        keep_as_previous(output)  # from another YAML, or fewer histories than asked: kept, never over an older one
     return False

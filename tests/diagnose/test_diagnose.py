@@ -7,6 +7,7 @@ lacks it. CI-sized: the slider-crank over one crank revolution.
 import json
 from pathlib import Path
 
+import h5py
 import pytest
 import yaml
 from typer.testing import CliRunner
@@ -70,6 +71,18 @@ def test_the_report_and_the_augmented_model(hidden_clearance):
     mechanism = load_mechanism(augmented).mechanism  # a valid mechanism file, with the clearance added
     joint = next(j for j in mechanism.joints if j.name == found["effects"][0]["target"])
     assert joint.clearance == pytest.approx(found["effects"][0]["parameters"]["clearance"])
+
+
+def test_the_model_runs_hold_the_sensors_alone(hidden_clearance):
+    """What a diagnosis reads of its runs is their sensors: the run files hold those (and the contact episodes),
+    not the bodies' states, the joint forces and the energies of a full result file."""
+    folder, _ = hidden_clearance
+    runs = sorted((folder / "report" / "runs").glob("*.h5"))
+    assert len(runs) > 5
+    with h5py.File(runs[0], "r") as handle:
+        assert handle.attrs["contents"] == "sensors"
+        assert set(SENSORS.split(",")) <= set(handle["sensors"])  # the model's sensors, the compared ones among them
+        assert "time" in handle and "bodies" not in handle and "energy" not in handle and "constraints" not in handle
 
 
 def test_noise_alone_finds_no_effect(tmp_path):

@@ -29,6 +29,17 @@ def test_missing_dataset_is_named(runs, tmp_path):
         in message
 
 
+def test_a_diagnosis_run_file_holding_the_sensors_alone_is_named_as_such(runs, tmp_path):
+    reduced = shutil.copy(runs["clearance"], tmp_path / "run.h5")
+    with h5py.File(reduced, "r+") as handle:  # as a diagnosis writes its model runs (contents = "sensors")
+        handle.attrs["contents"] = "sensors"
+        for group in ("bodies", "joints", "energy", "constraints"):
+            del handle[group]
+    message = fails(tmp_path, reduced)
+    assert "run.h5: holds the time and the sensors alone (a diagnosis's model run)" in message
+    assert "run its mechanism with `clearsim run` for every history" in message
+
+
 def test_animation_of_a_file_without_body_poses(runs, tmp_path):
     broken = shutil.copy(runs["clearance"], tmp_path / "nobody.h5")
     with h5py.File(broken, "r+") as handle:

@@ -66,13 +66,27 @@ def test_the_same_config_moved_or_copied_may_continue_its_sweep(tmp_path):
         raise AssertionError("another path with other text must be refused")
 
 
-def _result(path: Path, config_yaml: str) -> Path:
+def _result(path: Path, config_yaml: str, contents: str | None = None) -> Path:
     with h5py.File(path, "w") as handle:
         handle.attrs["clearsim_version"] = "0"
         handle.attrs["config_yaml"] = config_yaml
         handle.attrs["complete"] = True
         handle.attrs["status"] = "complete"
+        if contents is not None:
+            handle.attrs["contents"] = contents
     return path
+
+
+def test_a_file_with_the_sensors_alone_serves_a_diagnosis_run_not_a_sweep_case(tmp_path):
+    """A full file serves a case that asks for the sensors alone; a sensors-only file (a diagnosis's run) does not
+    serve a case that asks for every history: it is kept aside and the case runs."""
+    full = _result(tmp_path / "full.h5", "text")
+    assert _reusable(full, "text", retry_failed=False, contents="sensors")
+    assert _reusable(full, "text", retry_failed=False)
+    reduced = _result(tmp_path / "reduced.h5", "text", contents="sensors")
+    assert _reusable(reduced, "text", retry_failed=False, contents="sensors")
+    assert not _reusable(reduced, "text", retry_failed=False)
+    assert not reduced.exists() and (tmp_path / "reduced.previous.h5").exists()
 
 
 def test_a_result_of_another_yaml_is_kept_with_a_number_beside_the_earlier_kept_one(tmp_path):

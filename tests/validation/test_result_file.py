@@ -18,6 +18,20 @@ def run(tmp_path, name="sc.h5", overrides=SHORT, progress=None):
     return run_to_file(prepare(loaded), loaded, tmp_path / name, progress), loaded
 
 
+def test_a_file_of_the_sensors_alone_holds_the_full_files_sensors_bit_for_bit(tmp_path):
+    """contents="sensors" (a diagnosis's model runs): the time, the sensors and the contact episodes, equal to those
+    of the full file of the same run, and none of the other histories."""
+    full, loaded = run(tmp_path)
+    reduced = run_to_file(prepare(loaded), loaded, tmp_path / "sensors.h5", contents="sensors")
+    a, b = read_result(full.output), read_result(reduced.output)
+    assert b["attrs"]["contents"] == "sensors" and "contents" not in a["attrs"] and bool(b["attrs"]["complete"])
+    assert b["time"].shape == (301,) and np.array_equal(a["time"], b["time"])
+    sensors = [name for name in a if name.startswith("sensors/")]
+    assert sensors and all(np.array_equal(a[name], b[name]) for name in sensors)
+    assert {name for name in b if name != "attrs"} == {"time", *sensors} | {name for name in a if "/episodes/" in name}
+    assert reduced.output.stat().st_size < 0.3 * full.output.stat().st_size
+
+
 def test_layout_units_and_attributes(tmp_path):
     report, _ = run(tmp_path)
     with h5py.File(report.output) as f:

@@ -28,8 +28,8 @@ from clearsim.solver import precompile
 
 BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
 # which per-sample histories a result file holds (its `contents` attribute, absent for "all"): every dataset of
-# DESIGN.md §6, or the sensors alone — a diagnosis reads nothing else of its model runs (a UHV run at 100 kHz: 13.4 → 0.63 MB).
-# The contact modes' episode tables and the run's attributes are in both.
+# DESIGN.md §6, or the sensors alone — a diagnosis reads nothing else of its model runs (a UHV run at 100 kHz:
+# 13.4 → 0.63 MB). The contact modes' episode tables and the run's attributes are in both.
 CONTENTS = {"all": lambda name: True, "sensors": lambda name: name.startswith("sensors/")}
 DEFAULT_OUTPUT = Path("results") / "run.h5"
 RESULT_SUFFIXES = (".h5", ".hdf5", ".hdf")

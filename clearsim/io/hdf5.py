@@ -223,6 +223,11 @@ def read_result(path: Path, wanted: Callable[[str], bool] | None = None) -> dict
         return out
 
 
+def read_attributes(path: Path) -> dict:
+    """The root attributes of a result file, its datasets left unread (NotAResultFile as for read_result)."""
+    return read_result(path, lambda name: False)["attrs"]
+
+
 def group_attribute(path: Path, group: str, name: str, default=None):
     """One attribute of a group of a result file, or `default` when the group or attribute is absent."""
     with h5py.File(path, "r") as handle:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from clearsim.errors import ClearsimError
-from clearsim.io.hdf5 import NotAResultFile, ResultWriteError, keep_as_previous, read_result
+from clearsim.io.hdf5 import NotAResultFile, ResultWriteError, keep_as_previous, read_attributes
 from clearsim.model.loader import load_mechanism_text
 from clearsim.process import exit_without_final_collection
 from clearsim.runner import prepare, run_to_file
@@ -131,7 +131,7 @@ def finished_outcome(task: CaseTask) -> CaseOutcome | None:
         output = Path(task.output)
         if not output.exists():
             return None
-        attrs = read_result(output)["attrs"]
+        attrs = read_attributes(output)
         if attrs.get("complete") and _same_case(attrs, loaded.resolved_yaml, task.contents):
             return _outcome(task.name, output, loaded.mechanism.output, ran=True)
     except (ClearsimError, NotAResultFile, OSError):
@@ -158,7 +158,7 @@ def _reusable(output: Path, resolved_yaml: str, retry_failed: bool, contents: st
     if not output.exists():
         return False
     try:
-        attrs = read_result(output)["attrs"]
+        attrs = read_attributes(output)
     except (NotAResultFile, OSError):
         output.unlink()  # a file cut short by a hard kill
         return False

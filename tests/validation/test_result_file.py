@@ -2,9 +2,10 @@
 
 import h5py
 import numpy as np
+import pytest
 import yaml
 
-from clearsim.io.hdf5 import read_result
+from clearsim.io.hdf5 import NotAResultFile, read_attributes, read_result
 from clearsim.model.loader import load_mechanism, load_mechanism_text
 from clearsim.runner import prepare, run_to_file
 
@@ -30,6 +31,18 @@ def test_a_file_of_the_sensors_alone_holds_the_full_files_sensors_bit_for_bit(tm
     assert sensors and all(np.array_equal(a[name], b[name]) for name in sensors)
     assert {name for name in b if name != "attrs"} == {"time", *sensors} | {name for name in a if "/episodes/" in name}
     assert reduced.output.stat().st_size < 0.3 * full.output.stat().st_size
+
+
+def test_the_attributes_alone_are_those_of_the_whole_read_and_a_cut_file_is_refused(tmp_path):
+    """read_attributes (the sweep's reuse check) reads no dataset but gives the same attributes; a file cut short (a
+    hard kill, a full disk) is refused as not readable, so the case runs again."""
+    report, _ = run(tmp_path)
+    assert read_attributes(report.output) == read_result(report.output)["attrs"]
+    data = report.output.read_bytes()
+    cut = tmp_path / "cut.h5"
+    cut.write_bytes(data[:len(data) // 2])
+    with pytest.raises(NotAResultFile):
+        read_attributes(cut)
 
 
 def test_layout_units_and_attributes(tmp_path):

@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import csv
 import importlib.util
 import os
 import shutil
@@ -133,6 +134,44 @@ def diagnose_throughput(quick: bool, folder: Path, measurements, repeats: int = 
             "error": abs(hit["value"] / truth - 1.0) if hit else None,
             "gap_before": found[-1]["gap_before"], "gap_after": found[-1]["gap_after"]}
 
+KEEP_CLEARANCES = {False: "0.02,0.04,0.06,0.08,0.1,0.12", True: "0.05,0.1"}  # mm, the UHV at A and J
+
+
+def sweep_keep(quick: bool, folder: Path, measurements, repeats: int = 1) -> dict:
+    """A UHV clearance sweep (6 cases, no ideal case; with --quick 2 cases of 10 ms) on 2 workers with every
+    history in each file (`--keep all`, the default) and with the summary histories (`--keep summary`), alternated,
+    each repeat in new folders (at most 3 pairs): wall time, cases per minute and MB per case of each, and the
+    summary tables compared (they must agree)."""
+    import time
+
+    from clearsim.runner import BUNDLED_CONFIG
+    from clearsim.sweep import LocalPool, SweepRequest, plan_sweep, run_sweep
+
+    overrides = ["solver.t_end=10ms"] if quick else []
+    walls, sizes, summaries = {"all": [], "summary": []}, {}, {}
+    for repeat in range(min(repeats, 3)):
+        for keep in ("all", "summary") if repeat % 2 == 0 else ("summary", "all"):
+            out = folder / f"sweep-keep-{keep}-{repeat}"
+            request = SweepRequest(BUNDLED_CONFIG, list(overrides), KEEP_CLEARANCES[quick], "A,J", ideal=False,
+                                   out=out, keep=keep)
+            plan = plan_sweep(request, BUNDLED_CONFIG)
+            started = time.perf_counter()
+            run_sweep(plan, LocalPool(2))
+            walls[keep].append(time.perf_counter() - started)
+            files = sorted(out.glob("*.h5"))
+            sizes[keep] = sum(f.stat().st_size for f in files) / len(files) / 1e6
+            with (out / "summary.csv").open(newline="") as handle:  # the rows without the run-dependent columns
+                summaries[keep] = [{k: v for k, v in row.items() if k not in ("wall_time_s", "reused")}
+                                   for row in csv.DictReader(handle)]
+    cases = len(KEEP_CLEARANCES[quick].split(","))
+    result = {"cases": cases, "repeats": len(walls["all"]), "same_summary": summaries["all"] == summaries["summary"]}
+    for keep, times in walls.items():
+        median = statistics.median(times)
+        result[keep] = {"wall_median_s": median, "wall_min_s": min(times), "wall_max_s": max(times),
+                        "cases_per_minute": 60.0 * cases / median, "mb_per_case": sizes[keep]}
+    return result
+
+
 def describe(name: str, result) -> str:
     if name == "profile":
         return "\n".join(f"profile {r['case']}: wall {r['wall_s']:.2f} s = integration {r['integration_share']:.0%}, "
@@ -153,6 +192,12 @@ def describe(name: str, result) -> str:
         return (f"diagnose {result['study']}: {result['wall_median_s']:.1f} s [{result['wall_min_s']:.1f}, "
                 f"{result['wall_max_s']:.1f}] for {result['runs']} runs ({result['runs_per_minute']:.0f} runs/min); "
                 f"{found}; gap {result['gap_before']:.3g} → {result['gap_after']:.3g}")
+    if name == "sweep-keep":
+        full, kept = result["all"], result["summary"]
+        return (f"sweep-keep ({result['cases']} UHV cases, 2 workers, {result['repeats']} pairs): --keep all "
+                f"{full['wall_median_s']:.1f} s, {full['cases_per_minute']:.0f} cases/min, {full['mb_per_case']:.1f} "
+                f"MB/case; --keep summary {kept['wall_median_s']:.1f} s, {kept['cases_per_minute']:.0f} cases/min, "
+                f"{kept['mb_per_case']:.1f} MB/case; same summary: {result['same_summary']}")
     if name == "scaling":
         return "scaling (log–log slopes): " + ", ".join(f"{k} {v:.2f}" for k, v in result["orders"].items() if v is not None)
     return str(result)

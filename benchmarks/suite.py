@@ -407,7 +407,7 @@ def _studies() -> dict:
     return {"peer": exudyn_slider_crank.peer, "baseline": solve_ivp_slider_crank.baseline,
             "baseline-cartesian": solve_ivp_cartesian.baseline,
             "compile": extras.compile_time, "memory": extras.memory, "scaling": scaling.scaling,
-            "diagnose": extras.diagnose_throughput}
+            "diagnose": extras.diagnose_throughput, "sweep-keep": extras.sweep_keep}
 
 
 PROFILED = ("uhv-ideal", "uhv-c0.01", "uhv-c0.1")
@@ -418,7 +418,8 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="1 repeat, shortened cases, short sweep and studies")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--cases", help="comma-separated names (default: all): " + ", ".join(c.name for c in CASES)
-                        + ", sweep-8, profile, peer, baseline, baseline-cartesian, compile, memory, scaling, diagnose")
+                        + ", sweep-8, profile, peer, baseline, baseline-cartesian, compile, memory, scaling, diagnose, "
+                        "sweep-keep")
     parser.add_argument("--json", type=Path, default=RESULTS / "latest.json")
     parser.add_argument("--compare", type=Path, help="an earlier JSON: wall-time ratios per case")
     args = parser.parse_args(argv)
@@ -467,7 +468,7 @@ def main(argv=None) -> int:
         console.print(at_peer_accuracy(document))
     if "baseline-cartesian" in document:
         console.print(cartesian_ladder(document))
-    for name in ("profile", "compile", "memory", "scaling", "diagnose"):
+    for name in ("profile", "compile", "memory", "scaling", "diagnose", "sweep-keep"):
         if name in document:
             console.print(extras.describe(name, document[name]))
     args.json.parent.mkdir(parents=True, exist_ok=True)

@@ -27,10 +27,21 @@ from clearsim.solver.simulate import Chunk, Run, Statistics
 from clearsim.solver import precompile
 
 BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
-# which per-sample histories a result file holds (its `contents` attribute, absent for "all"): every dataset of
-# DESIGN.md §6, or the sensors alone — a diagnosis reads nothing else of its model runs (a UHV run at 100 kHz:
-# 13.4 → 0.63 MB). The contact modes' episode tables and the run's attributes are in both.
-CONTENTS = {"all": lambda name: True, "sensors": lambda name: name.startswith("sensors/")}
+# which per-sample histories a result file holds (its `contents` attribute, absent for "all"), each a subset of the
+# one before: every dataset of DESIGN.md §6; "summary", all but the bodies' q, q̇, q̈ and the ideal joints' reactions
+# — what a sweep's summary table and `clearsim plot`'s figures read (`clearsim sweep --keep summary`; a UHV case at
+# 100 kHz 13.4 → 3.1 MB); or the sensors alone — a diagnosis reads nothing else of its model runs (0.63 MB). The
+# contact modes' episode tables and the run's attributes are in every file.
+CONTENTS = {"all": lambda name: True,
+            "summary": lambda name: not name.startswith("bodies/") and not name.endswith("/reaction"),
+            "sensors": lambda name: name.startswith("sensors/")}
+
+
+def contents_serve(held: str, wanted: str) -> bool:
+    """Whether a file holding `held` histories has every history `wanted` asks for (CONTENTS: each a subset of the
+    one before; an unknown value serves nothing)."""
+    order = list(CONTENTS)
+    return held in order and wanted in order and order.index(held) <= order.index(wanted)
 DEFAULT_OUTPUT = Path("results") / "run.h5"
 RESULT_SUFFIXES = (".h5", ".hdf5", ".hdf")
 
@@ -117,7 +128,7 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     computed is written when the run ends, fails or is interrupted.
     """
     output = Path(output)
-    check_free_space(output, result_file_bytes(system))
+    check_free_space(output, result_file_bytes(system, contents))
     backup = keep_as_previous(output)
     run = None  # made inside the try: loading the compiled kernels can take seconds, and may be interrupted
     episodes, status, complete, error = [], "complete", True, None
@@ -166,12 +177,20 @@ def element_place(loaded: LoadedMechanism, element: str | None) -> str:
     return f"{at}  {format_path(path, loaded.source.names)}"
 
 
-def result_file_bytes(system: System) -> float:
-    """An upper estimate of the result file's size: the datasets of DESIGN.md §6 at 8 bytes a value, 20 % over."""
+def result_file_bytes(system: System, contents: str = "all") -> float:
+    """An upper estimate of the result file's size: the datasets of DESIGN.md §6 that `contents` keeps, at 8 bytes
+    a value, 20 % over."""
     settings = system.mechanism.solver
     samples = settings.t_end * settings.output_rate + 1
-    per_sample = (1 + 9 * len(system.body_names) + 2 * (len(system.pin_joints) + len(system.prismatic_joints))
-                  + 8 * len(system.clearance_joints) + len(system.drivers) + len(system.sensors) + 9)
+    values = {  # a dataset of each group → values per sample of the group
+        "bodies/b/q": 9 * len(system.body_names),
+        "joints/j/reaction": 2 * (len(system.pin_joints) + len(system.prismatic_joints)),
+        "joints/j/normal_force": 8 * len(system.clearance_joints),
+        "drivers/d/effort": len(system.drivers),
+        "sensors/s": len(system.sensors),
+        "energy/e": 9,
+    }
+    per_sample = 1 + sum(count for name, count in values.items() if CONTENTS[contents](name))
     return 1.2 * 8 * per_sample * samples + 2**20
 
 

@@ -64,10 +64,10 @@ class RunData:
     def require(self, key: str, purpose: str) -> None:
         if key in self.datasets:
             return
-        if self.attrs.get("contents") == "sensors":
-            raise PlotInputError(f"{self.path}: holds the time and the sensors alone (a diagnosis's model run), no "
-                                 f"/{key} for {purpose}; run its mechanism with `clearsim run` for every history "
-                                 "(the file's config_yaml attribute is the mechanism)")
+        held = REDUCED_CONTENTS.get(str(self.attrs.get("contents", "all")))
+        if held is not None:
+            raise PlotInputError(f"{self.path}: holds {held}, no /{key} for {purpose}; run its mechanism with "
+                                 "`clearsim run` for every history (the file's config_yaml attribute is the mechanism)")
         raise PlotInputError(f"{self.path}: no dataset /{key} (needed for {purpose}); "
                              "the file may come from an interrupted run or an older clearsim")
 
@@ -81,6 +81,13 @@ class RunData:
 
     def sensors(self) -> list[str]:
         return [key.split("/", 1)[1] for key in self.datasets if key.startswith("sensors/")]
+
+
+# what a file with fewer histories than DESIGN.md §6 holds (its `contents` attribute, runner.CONTENTS)
+REDUCED_CONTENTS = {
+    "summary": "the histories a sweep keeps with --keep summary (no bodies' motion, no ideal joints' reactions)",
+    "sensors": "the time and the sensors alone (a diagnosis's model run)",
+}
 
 
 def _units(path: Path) -> dict:

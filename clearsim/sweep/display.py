@@ -82,7 +82,8 @@ def percentile_table(entries: list[dict]) -> Table:
 
 
 def opening_line(plan: SweepPlan, where: str) -> str:
-    return f"sweep of {len(plan.cases)} cases of {plan.config.name} on {where} → {plan.folder}"
+    kept = "" if plan.keep == "all" else f" (each file: the {plan.keep} histories)"
+    return f"sweep of {len(plan.cases)} cases of {plan.config.name} on {where} → {plan.folder}{kept}"
 
 
 def _cases(count: int) -> str:

@@ -45,7 +45,7 @@ def case_file(plan: SweepPlan, name: str) -> Path:
 
 def tasks_of(plan: SweepPlan, retry_failed: bool = False) -> list[CaseTask]:
     return [CaseTask(case.name, plan.config_text, str(plan.config), str(plan.base_dir), case.overrides,
-                     str(case_file(plan, case.name)), retry_failed) for case in plan.cases]
+                     str(case_file(plan, case.name)), retry_failed, plan.keep) for case in plan.cases]
 
 
 def run_sweep(plan: SweepPlan, executor, progress: Progress | None = None,

@@ -19,7 +19,7 @@ from clearsim.errors import ClearsimError
 from clearsim.io.hdf5 import NotAResultFile, ResultWriteError, keep_as_previous, read_attributes
 from clearsim.model.loader import load_mechanism_text
 from clearsim.process import exit_without_final_collection
-from clearsim.runner import prepare, run_to_file
+from clearsim.runner import contents_serve, prepare, run_to_file
 from clearsim.sweep.figures import CaseRecord, read_record
 
 COMPLETE, FAILED, INTERRUPTED, NOT_RUN = "complete", "failed", "interrupted", "not run"
@@ -36,7 +36,7 @@ class CaseTask:
     overrides: tuple[str, ...]
     output: str
     retry_failed: bool = False
-    contents: str = "all"  # the histories its file holds (runner.CONTENTS): a diagnosis asks for the sensors alone
+    contents: str = "all"  # the histories its file holds (runner.CONTENTS): `--keep summary`, a diagnosis the sensors
 
 
 @dataclass
@@ -149,8 +149,7 @@ def _outcome(name: str, output: Path, output_sensors, ran: bool) -> CaseOutcome:
 
 def _same_case(attrs, resolved_yaml: str, contents: str) -> bool:
     """A file written from this YAML that holds what the case asks for (a full file serves any case)."""
-    held = str(attrs.get("contents", "all"))
-    return attrs.get("config_yaml") == resolved_yaml and held in ("all", contents)
+    return attrs.get("config_yaml") == resolved_yaml and contents_serve(str(attrs.get("contents", "all")), contents)
 
 
 def _reusable(output: Path, resolved_yaml: str, retry_failed: bool, contents: str = "all") -> bool:

@@ -113,3 +113,14 @@ def test_the_diagnosis_benchmark_finds_the_hidden_clearance_and_counts_its_runs(
         assert effect["value"] == pytest.approx(0.2e-3, rel=0.3) and result["error"] < 0.3
         assert "found clearance slider_pin" in describe("diagnose", result)
     assert result["gap_after"] < 0.6 * result["gap_before"]
+
+
+def test_the_sweep_keep_benchmark_compares_equal_summaries_and_the_file_sizes(tmp_path):
+    from benchmarks.extras import describe, sweep_keep
+
+    result = sweep_keep(quick=True, folder=tmp_path, measurements=[], repeats=1)
+    assert result["cases"] == 2 and result["repeats"] == 1 and result["same_summary"]
+    full, summary = result["all"], result["summary"]
+    assert summary["mb_per_case"] < full["mb_per_case"] / 3  # the UHV's nine bodies and twelve reactions left out
+    assert full["cases_per_minute"] == pytest.approx(60.0 * 2 / full["wall_median_s"])
+    assert "same summary: True" in describe("sweep-keep", result)

@@ -40,6 +40,24 @@ def test_a_diagnosis_run_file_holding_the_sensors_alone_is_named_as_such(runs, t
     assert "run its mechanism with `clearsim run` for every history" in message
 
 
+def test_a_sweep_summary_file_plots_its_figures_and_names_itself_for_the_animation(runs, tmp_path):
+    """A `--keep summary` case file has what the standard figures read; the animation needs the bodies' poses, and
+    the message says which kind of file this is instead of calling it interrupted."""
+    reduced = shutil.copy(runs["clearance"], tmp_path / "case.h5")
+    with h5py.File(reduced, "r+") as handle:  # as `clearsim sweep --keep summary` writes its cases
+        handle.attrs["contents"] = "summary"
+        del handle["bodies"]
+        for joint in [name for name in handle["joints"] if "reaction" in handle["joints"][name]]:
+            del handle[f"joints/{joint}/reaction"]
+    plotted = runner.invoke(app, ["plot", str(reduced), "--out", str(tmp_path / "plotted")])
+    assert plotted.exit_code == 0, plotted.output
+    assert {p.name for p in (tmp_path / "plotted").iterdir()} >= {"case-output.png", "case-joint-slider_pin.png",
+                                                                "case-energy.png"}
+    message = fails(tmp_path, reduced, "--animate")
+    assert "case.h5: holds the histories a sweep keeps with --keep summary" in message
+    assert "no /bodies/" in message and "for the animation" in message
+
+
 def test_animation_of_a_file_without_body_poses(runs, tmp_path):
     broken = shutil.copy(runs["clearance"], tmp_path / "nobody.h5")
     with h5py.File(broken, "r+") as handle:

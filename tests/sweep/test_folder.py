@@ -89,6 +89,19 @@ def test_a_file_with_the_sensors_alone_serves_a_diagnosis_run_not_a_sweep_case(t
     assert not reduced.exists() and (tmp_path / "reduced.previous.h5").exists()
 
 
+def test_a_summary_file_serves_a_summary_or_diagnosis_case_not_a_full_one(tmp_path):
+    """`--keep summary` files serve a later `--keep summary` sweep (and a diagnosis), a full file serves them too;
+    a sweep asking for every history keeps the summary file aside and runs the case."""
+    assert _reusable(_result(tmp_path / "full.h5", "text"), "text", retry_failed=False, contents="summary")
+    summary = _result(tmp_path / "summary.h5", "text", contents="summary")
+    assert _reusable(summary, "text", retry_failed=False, contents="summary")
+    assert _reusable(summary, "text", retry_failed=False, contents="sensors")
+    sensors = _result(tmp_path / "sensors.h5", "text", contents="sensors")
+    assert not _reusable(sensors, "text", retry_failed=False, contents="summary")
+    assert not _reusable(summary, "text", retry_failed=False)
+    assert not summary.exists() and (tmp_path / "summary.previous.h5").exists()
+
+
 def test_a_result_of_another_yaml_is_kept_with_a_number_beside_the_earlier_kept_one(tmp_path):
     output = _result(tmp_path / "case.h5", "second")
     oldest = _result(tmp_path / "case.previous.h5", "first")

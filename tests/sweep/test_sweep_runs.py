@@ -9,6 +9,7 @@ import pytest
 from typer.testing import CliRunner
 
 from clearsim.cli import app
+from clearsim.io.hdf5 import read_attributes
 from clearsim.runner import summarize
 from clearsim.sweep import LocalPool, SweepRequest, plan_sweep, run_sweep
 
@@ -106,6 +107,30 @@ def test_a_rerun_runs_only_the_missing_case(pool_sweep, tmp_path):
     assert [rows[c]["reused"] for c in CASES] == ["yes", "no", "yes"]
     assert {c: numbers(r) for c, r in rows.items()} == {c: numbers(r) for c, r in read_summary(pool_sweep[0]).items()}
     assert not list(out.glob("*.previous*.h5"))
+
+
+def test_keep_summary_gives_the_same_summary_from_smaller_files_and_reuse_follows_what_they_hold(pool_sweep, tmp_path):
+    """`--keep summary`: the summary numbers of the full sweep, each file flagged and smaller; a full folder serves
+    a `--keep summary` sweep as it is, a summary folder does not serve a full sweep (its files are kept aside)."""
+    out = tmp_path / "summary"
+    result = invoke("sweep", SLIDER_CRANK, "--set", SHORT, "--clearance", CLEARANCES, "--workers", 2, "-o", out,
+                    "--keep", "summary")
+    assert result.exit_code == 0, result.output
+    assert "(each file: the summary histories)" in result.output
+    full = read_summary(pool_sweep[0])
+    assert {c: numbers(r) for c, r in read_summary(out).items()} == {c: numbers(r) for c, r in full.items()}
+    for case in CASES:
+        assert read_attributes(out / f"{case}.h5")["contents"] == "summary"
+        assert (out / f"{case}.h5").stat().st_size < 0.6 * (pool_sweep[0] / f"{case}.h5").stat().st_size
+    served = tmp_path / "served"
+    shutil.copytree(pool_sweep[0], served)
+    keep_summary = SweepRequest(SLIDER_CRANK, [SHORT], CLEARANCES, out=served, keep="summary")
+    assert run_sweep(plan_sweep(keep_summary, SLIDER_CRANK), LocalPool(2)).ran == []
+    everything = run_sweep(plan_sweep(SweepRequest(SLIDER_CRANK, [SHORT], CLEARANCES, out=out), SLIDER_CRANK),
+                           LocalPool(2))
+    assert sorted(everything.ran) == sorted(CASES)
+    assert sorted(p.name for p in out.glob("*.previous.h5")) == sorted(f"{c}.previous.h5" for c in CASES)
+    assert all("contents" not in read_attributes(out / f"{case}.h5") for case in CASES)
 
 
 def test_a_failing_case_is_recorded_and_the_others_finish(tmp_path):

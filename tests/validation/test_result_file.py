@@ -7,7 +7,7 @@ import yaml
 
 from clearsim.io.hdf5 import NotAResultFile, read_attributes, read_result
 from clearsim.model.loader import load_mechanism, load_mechanism_text
-from clearsim.runner import prepare, run_to_file
+from clearsim.runner import contents_serve, prepare, result_file_bytes, run_to_file
 
 from .conftest import CONFIGS
 
@@ -31,6 +31,32 @@ def test_a_file_of_the_sensors_alone_holds_the_full_files_sensors_bit_for_bit(tm
     assert sensors and all(np.array_equal(a[name], b[name]) for name in sensors)
     assert {name for name in b if name != "attrs"} == {"time", *sensors} | {name for name in a if "/episodes/" in name}
     assert reduced.output.stat().st_size < 0.3 * full.output.stat().st_size
+
+
+def test_a_summary_file_holds_every_history_but_the_bodies_and_reactions_bit_for_bit(tmp_path):
+    """contents="summary" (`clearsim sweep --keep summary`): the full file's datasets without /bodies/ and the ideal
+    joints' /reaction, each equal to the full file's; the clearance joints' histories, energies, drivers, sensors and
+    the constraint violation all there; the size estimate that guards the free disk space shrinks to match."""
+    full, loaded = run(tmp_path)  # the slider-crank with its clearance joint slider_pin
+    system = prepare(loaded)
+    reduced = run_to_file(system, loaded, tmp_path / "summary.h5", contents="summary")
+    a, b = read_result(full.output), read_result(reduced.output)
+    assert b["attrs"]["contents"] == "summary" and bool(b["attrs"]["complete"])
+    dropped = {name for name in a if name.startswith("bodies/") or name.endswith("/reaction")}
+    assert len(dropped) == 3 * 3 + 3  # q, q̇, q̈ of three bodies; the three ideal joints' reactions
+    assert set(b) == set(a) - dropped
+    assert {"joints/slider_pin/eccentricity", "joints/slider_pin/normal_force", "energy/kinetic",
+            "constraints/violation", "drivers/crank_drive/effort", "sensors/slider_acceleration"} <= set(b)
+    assert all(np.array_equal(a[name], b[name]) for name in b if name != "attrs")
+    assert reduced.output.stat().st_size < 0.6 * full.output.stat().st_size
+    assert result_file_bytes(system, "sensors") < result_file_bytes(system, "summary") < result_file_bytes(system)
+
+
+def test_which_files_serve_which_contents():
+    """Each contents is a subset of the one before: all ⊇ summary ⊇ sensors; an unknown value serves nothing."""
+    assert [held for held in ("all", "summary", "sensors") if contents_serve(held, "summary")] == ["all", "summary"]
+    assert contents_serve("summary", "sensors") and not contents_serve("sensors", "summary")
+    assert not contents_serve("summary", "all") and not contents_serve("bodies", "sensors")
 
 
 def test_the_attributes_alone_are_those_of_the_whole_read_and_a_cut_file_is_refused(tmp_path):

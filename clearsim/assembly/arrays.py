@@ -20,6 +20,10 @@ import numpy as np
 from numba import njit, types
 from numba.experimental import structref
 
+from clearsim import numba_inlining
+
+numba_inlining.install()  # before any kernel compiles: numba's inliner copies each callee's IR once, not per block
+
 # columns of clearance_params
 CL_BEARING_POINT = 0  # 0, 1: bearing centre in the bearing body's frame
 CL_JOURNAL_POINT = 2  # 2, 3: journal centre in the journal body's frame

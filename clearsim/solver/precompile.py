@@ -7,8 +7,10 @@ run (`prepare`) starts `python -m clearsim.solver.precompile`, which compiles in
 run's typing of `advance` needs early (`AHEAD`) and then those taken by address in the reverse order, the largest
 first (`kernels_ahead`). When the run reaches a kernel
 the helper has already written, numba loads it from the cache instead of compiling it (the same machine code: the
-cache is keyed by the sources and the signature), so the two processes meet in the middle of that list.
-Nothing waits for the helper: a kernel both processes reach first is compiled by both, which costs CPU only.
+cache is keyed by the sources and the signature), so the two processes meet in the middle of that list. Where they
+meet, the run waits for the kernel the helper is compiling at that moment (the helper names it in BUSY_NAME) and
+loads it, instead of compiling it too (`compile_addressed`); anything else the two reach first is compiled by both,
+which costs CPU only.
 
 Only one helper runs per cache (a lock file), only with two or more cores, and never when the variable
 CLEARSIM_COMPILE_AHEAD is 0. The helper's output is discarded; if it fails, the run compiles what it needs
@@ -22,6 +24,7 @@ import importlib
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -33,6 +36,9 @@ from clearsim.assembly.dynamics import dynamics_type
 from clearsim.solver.integrator import addressed_kernels, advance
 
 LOCK_NAME = "compile-ahead.lock"
+BUSY_NAME = "compile-ahead.busy"  # the kernel the helper is compiling now, for the run to wait for instead
+WAIT_POLL = 0.02  # s between two looks at it
+WAIT_LIMIT = 120.0  # s at most: a helper that has stopped moving on is not waited for any longer
 DISABLE_VARIABLE = "CLEARSIM_COMPILE_AHEAD"
 
 F, I = types.float64, types.int64
@@ -147,11 +153,53 @@ def compile_ahead() -> list[str]:
         except OSError:
             return []  # another helper is compiling into this cache
         done = []
+        busy = folder / BUSY_NAME
         with blas_hidden():
             for kernel, signature in kernels_ahead():
+                busy.write_text(_name(kernel))
                 kernel.compile(signature)
                 done.append(kernel.py_func.__name__)
+        busy.unlink(missing_ok=True)
         return done
+
+
+def _name(kernel) -> str:
+    return f"{kernel.py_func.__module__}.{kernel.py_func.__qualname__}"
+
+
+def _busy_with() -> str:
+    """The kernel the helper is compiling now ("" when none, or unreadable)."""
+    try:
+        return (Path(config.CACHE_DIR) / BUSY_NAME).read_text()
+    except (OSError, TypeError):
+        return ""
+
+
+def wait_while_helper_compiles(kernel) -> float:
+    """When this process's helper is compiling `kernel` now, wait until it has moved on or ended (at most WAIT_LIMIT):
+    the kernel is then in the cache to be loaded instead of compiled a second time here. Returns the seconds waited."""
+    if _helper is None or not config.CACHE_DIR:
+        return 0.0
+    started = time.monotonic()
+    while _busy_with() == _name(kernel) and _helper.poll() is None and time.monotonic() - started < WAIT_LIMIT:
+        time.sleep(WAIT_POLL)
+    return time.monotonic() - started
+
+
+_addressed_ready = False
+
+
+def compile_addressed(kernel_arrays) -> None:
+    """Before the loop's first call in a process: each kernel `advance` takes by address compiled here, or loaded from
+    the cache, in advance's argument order, as the call would convert them — except that one the helper is compiling
+    at that moment is waited for and loaded, not compiled by both processes (where the two meet in the middle)."""
+    global _addressed_ready
+    if _addressed_ready:
+        return
+    for kernel, kind in addressed_kernels(typeof(kernel_arrays)):
+        wait_while_helper_compiles(kernel)
+        kernel.compile(kind.signature)
+    _addressed_ready = True
 
 
 if __name__ == "__main__":

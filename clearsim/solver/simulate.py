@@ -179,7 +179,9 @@ class Run:
         started = clock.perf_counter()
         arguments = ig.loop_arguments(self.kernel_arrays, self.y, self.f, self.real, self.ints, self.modes, self.speeds,
                                       self.episode_of, *self.log, self.peak_force, *self.buffers, t_stop)
-        ig.compiled_loop(arguments)(*arguments)
+        loop = ig.compiled_loop(arguments)
+        precompile.compile_addressed(self.kernel_arrays)  # once per process, before the loop's first call
+        loop(*arguments)
         if self.ints[ig.I_STATUS] == ig.FIRST_STEP:  # the first call: loads (or compiles) the loop, one rhs
             self.kernel_time += clock.perf_counter() - started
             precompile.reap_helper()

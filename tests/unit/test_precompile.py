@@ -84,3 +84,50 @@ def test_every_kernel_ahead_exists_with_its_number_of_arguments():
     for kernel, signature in precompile.kernels_ahead():
         arguments = getattr(signature, "args", signature)  # a tuple of types, or a Signature with its return type
         assert len(inspect.signature(kernel.py_func).parameters) == len(arguments), kernel.py_func.__name__
+
+
+class _Compiling:
+    """A helper process still running."""
+
+    def poll(self):
+        return None
+
+
+def test_the_run_waits_for_a_kernel_the_helper_is_compiling_and_for_no_other(tmp_path, monkeypatch):
+    """Where the two processes meet, the run waits for the helper's kernel (then loads it) instead of compiling it
+    too; a kernel the helper is not on, or no helper of this process, is not waited for."""
+    import threading
+
+    from clearsim.solver.integrator import project_state, switch_mode
+
+    monkeypatch.setattr(config, "CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(precompile, "_helper", _Compiling())
+    busy = tmp_path / precompile.BUSY_NAME
+    busy.write_text(precompile._name(project_state))
+    assert precompile.wait_while_helper_compiles(switch_mode) < precompile.WAIT_POLL
+    moved_on = threading.Timer(0.3, lambda: busy.write_text(precompile._name(switch_mode)))
+    moved_on.start()
+    assert 0.3 <= precompile.wait_while_helper_compiles(project_state) < 5.0
+    moved_on.join()
+    monkeypatch.setattr(precompile, "_helper", _Finished())  # a helper that has ended is not waited for
+    assert precompile.wait_while_helper_compiles(switch_mode) < precompile.WAIT_POLL
+    monkeypatch.setattr(precompile, "_helper", None)
+    assert precompile.wait_while_helper_compiles(switch_mode) == 0.0
+
+
+def test_the_helper_says_which_kernel_it_is_compiling_and_clears_it_at_the_end(tmp_path, monkeypatch):
+    seen = []
+    kernels = precompile.kernels_ahead()[:2]
+
+    class _Recording:
+        def __init__(self, kernel):
+            self.py_func = kernel.py_func
+
+        def compile(self, signature):
+            seen.append((tmp_path / precompile.BUSY_NAME).read_text())
+
+    monkeypatch.setattr(config, "CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(precompile, "kernels_ahead", lambda: [(_Recording(k), s) for k, s in kernels])
+    assert precompile.compile_ahead() == [k.py_func.__name__ for k, _ in kernels]
+    assert seen == [precompile._name(k) for k, _ in kernels]
+    assert not (tmp_path / precompile.BUSY_NAME).exists()

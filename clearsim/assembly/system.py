@@ -16,7 +16,7 @@ import numpy as np
 from clearsim.assembly import build
 from clearsim.assembly.arrays import KernelArrays, SystemArrays, for_kernels, mass_diagonal
 from clearsim.assembly.build import BuildError, ConstraintRows, Laws, Poses
-from clearsim.assembly.constraints import constraint_count, evaluate_constraints, evaluate_jacobian, evaluate_velocity_rhs
+from clearsim.assembly.constraints import constraint_count, dense_jacobian, evaluate_constraints, evaluate_velocity_rhs
 from clearsim.errors import Problem
 from clearsim.model import schema
 from clearsim.physics import motion
@@ -139,13 +139,11 @@ def _newton_assembly(arrays: KernelArrays, q: np.ndarray, owners: list[str]) -> 
     if m == 0:
         return q
     phi = np.empty(m)
-    jac = np.empty((m, q.size))
     for _ in range(ASSEMBLY_ITERATIONS):
         evaluate_constraints(arrays, 0.0, q, phi)
         if np.max(np.abs(phi)) <= ASSEMBLY_TOLERANCE:
             return q
-        evaluate_jacobian(arrays, q, jac)
-        q = q - np.linalg.lstsq(jac, phi, rcond=None)[0]
+        q = q - np.linalg.lstsq(dense_jacobian(arrays, q), phi, rcond=None)[0]
     worst = [owners[i] for i in np.argsort(-np.abs(phi))[:3] if abs(phi[i]) > ASSEMBLY_TOLERANCE]
     names = ", ".join(dict.fromkeys(worst))
     raise BuildError([Problem(("joints",), f"the mechanism cannot be assembled at t = 0: joints {names} cannot close "
@@ -159,8 +157,7 @@ def _consistent_velocities(arrays: KernelArrays, q: np.ndarray, qd: np.ndarray, 
     m = constraint_count(arrays)
     if m == 0:
         return qd
-    jac = np.empty((m, q.size))
-    evaluate_jacobian(arrays, q, jac)
+    jac = dense_jacobian(arrays, q)
     nu = np.empty(m)
     evaluate_velocity_rhs(arrays, 0.0, nu)
     for k, clearance in enumerate(clearances):  # pin rows P_B + e0 − P_J: d/dt = −ė0
@@ -176,8 +173,7 @@ def _check_rank(arrays: KernelArrays, q: np.ndarray, owners: list[str]) -> int:
     m = constraint_count(arrays)
     if m == 0:
         return 0
-    jac = np.empty((m, q.size))
-    evaluate_jacobian(arrays, q, jac)
+    jac = dense_jacobian(arrays, q)
     u, sigma, _ = np.linalg.svd(jac)
     tolerance = max(jac.shape) * np.finfo(float).eps * 1e3 * max(sigma[0], 1.0)
     rank = int(np.sum(sigma > tolerance))

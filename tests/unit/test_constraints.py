@@ -5,7 +5,7 @@ import pytest
 
 from clearsim.assembly.arrays import CLEARANCE_COLUMNS, LOAD_COLUMNS, SPRING_COLUMNS, KernelArrays, SystemArrays, for_kernels
 from clearsim.assembly.constraints import (
-    constraint_count, evaluate_acceleration_rhs, evaluate_constraints, evaluate_jacobian, evaluate_velocity_rhs,
+    constraint_count, dense_jacobian, evaluate_acceleration_rhs, evaluate_constraints, evaluate_velocity_rhs,
 )
 from clearsim.physics import motion
 
@@ -44,8 +44,7 @@ def state():
 def test_jacobian_matches_finite_differences(state):
     system = mixed_system()
     t, q, _, _ = state
-    jac = np.zeros((constraint_count(system), 9))
-    evaluate_jacobian(system, q, jac)
+    jac = dense_jacobian(system, q)
     step = 1e-7
     numeric = np.column_stack([(phi(system, t, q + step * e) - phi(system, t, q - step * e)) / (2 * step)
                                for e in np.eye(9)])
@@ -56,8 +55,7 @@ def test_velocity_and_acceleration_rhs_match_the_second_time_derivative(state):
     system = mixed_system()
     t, q, qd, qdd = state
     m = constraint_count(system)
-    jac, nu, gamma = np.zeros((m, 9)), np.zeros(m), np.zeros(m)
-    evaluate_jacobian(system, q, jac)
+    jac, nu, gamma = dense_jacobian(system, q), np.zeros(m), np.zeros(m)
     evaluate_velocity_rhs(system, t, nu)
     evaluate_acceleration_rhs(system, t, q, qd, gamma)
     h = 1e-4

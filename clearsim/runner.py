@@ -42,6 +42,8 @@ def contents_serve(held: str, wanted: str) -> bool:
     one before; an unknown value serves nothing)."""
     order = list(CONTENTS)
     return held in order and wanted in order and order.index(held) <= order.index(wanted)
+
+
 DEFAULT_OUTPUT = Path("results") / "run.h5"
 RESULT_SUFFIXES = (".h5", ".hdf5", ".hdf")
 

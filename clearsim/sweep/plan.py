@@ -20,11 +20,7 @@ from clearsim.model.resolve import is_clearance_joint
 from clearsim.sweep import grid, montecarlo
 from clearsim.sweep.grid import Case, SweepOptionError
 
-# what `--keep` may ask each case's file to hold (runner.CONTENTS)
-KEEP = {"all": "every history of the result-file layout (the default)",
-        "summary": "summary keeps the sensors, the clearance joints' histories, the energies, the drivers' efforts and "
-                   "the constraint violation (what the summary table and `clearsim plot` read), without the bodies' "
-                   "q, q̇, q̈ and the ideal joints' reactions: a UHV case 13.4 → 3.1 MB"}
+KEEP = ("all", "summary")  # what `--keep` may ask each case's file to hold (runner.CONTENTS)
 
 RESULTS = Path("results")
 MAX_CASES = 100_000  # each case is loaded and checked before anything runs (~3 ms each): 5 minutes of planning
@@ -93,7 +89,9 @@ def _check_request(request: SweepRequest) -> None:
     if request.seed < 0:
         raise SweepOptionError(f"--seed must be 0 or more, got {request.seed}")
     if request.keep not in KEEP:
-        raise SweepOptionError(f"--keep must be {' or '.join(KEEP)}, got '{request.keep}'\n  hint: {KEEP['summary']}")
+        raise SweepOptionError(f"--keep must be {' or '.join(KEEP)}, got '{request.keep}'\n  hint: all (the default) "
+                               "keeps every history; summary leaves out the bodies' motion and the ideal joints' "
+                               "reactions (docs/sweeps.md §2)")
 
 
 def _grid(request: SweepRequest, mechanism, fixed, swept) -> tuple[list[Case], list[str]]:

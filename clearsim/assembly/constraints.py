@@ -128,10 +128,8 @@ def dense_jacobian(system, q: np.ndarray) -> np.ndarray:
     """Φ_q as a dense (m, 3 nb) matrix, scattered with numpy from the blocks the solver works on (the assembly's
     Newton steps and checks, tests). Not a kernel: the blocks' kernel is compiled for the loop anyway, and a kernel
     of its own cost a first run ~1.5 s of compiling before the loop's (docs/performance.md, Session 14)."""
-    m = constraint_count(system)
-    blocks, bodies = np.empty((m, 2, 3)), np.empty((m, 2), np.int64)
-    evaluate_jacobian_blocks(system, q, blocks, bodies)
-    jac = np.zeros((m, q.shape[0]))
+    blocks, bodies = jacobian_blocks(system, q)
+    jac = np.zeros((blocks.shape[0], q.shape[0]))
     rows, slots = np.nonzero(bodies >= 0)  # the ground (−1) has no columns
     columns = 3 * bodies[rows, slots][:, None] + np.arange(3)
     np.add.at(jac, (rows[:, None], columns), blocks[rows, slots])

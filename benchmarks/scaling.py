@@ -68,8 +68,6 @@ def validates(text: str, folder: Path) -> bool:
     path = folder / "chain-validate.yaml"
     path.write_text(text)
     done = subprocess.run([sys.executable, "-m", "clearsim.cli", "validate", str(path)], capture_output=True, text=True)
-    if done.returncode:
-        done = subprocess.run(["clearsim", "validate", str(path)], capture_output=True, text=True)
     return done.returncode == 0
 
 

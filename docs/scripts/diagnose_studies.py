@@ -14,6 +14,7 @@ import argparse
 import json
 import shutil
 import subprocess
+import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,6 +26,7 @@ from clearsim.diagnose.evaluate import document_text
 from clearsim.model.loader import load_mechanism
 
 CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
+CLEARSIM = [sys.executable, "-m", "clearsim.cli"]  # the clearsim this interpreter imports, on PATH or not
 UHV, SLIDER_CRANK = CONFIGS / "uhv_breaker.yaml", CONFIGS / "slider_crank_flores.yaml"
 FRICTION_CRANK = CONFIGS / "slider_crank_flores_friction.yaml"
 UHV_BENCH = ["--sensors", "sealing_rod_displacement,turn_arm_angular_velocity", "--rate", "15kHz",
@@ -93,14 +95,14 @@ def run_study(study: Study, root: Path) -> dict:
     if not record.exists():
         source = truth_model(study, folder)
         hidden = sets(study.model + study.hidden) if source == study.config else []
-        subprocess.run(["clearsim", "synthesize", str(source), *hidden, *study.bench,
+        subprocess.run([*CLEARSIM, "synthesize", str(source), *hidden, *study.bench,
                         "--noise", study.noise, "--seed", str(study.seed), "-o", str(record)], check=True,
                        capture_output=True)
     report = folder / "report"
     for old in report.glob("diagnosis*.json"):
         old.unlink()
     started = time.perf_counter()
-    subprocess.run(["clearsim", "diagnose", str(study.config), *sets(study.model), "--measured", str(record),
+    subprocess.run([*CLEARSIM, "diagnose", str(study.config), *sets(study.model), "--measured", str(record),
                     "-o", str(report), *study.options], check=True, capture_output=True)
     found = json.loads((report / "diagnosis.json").read_text())
     found["wall_s"] = time.perf_counter() - started

@@ -15,7 +15,7 @@ LINKED_PAGES = [ROOT / "README.md", *PAGES]
 PAGES_MAINTAINED_ELSEWHERE = {"yaml.md", "plotting.md", "sweeps.md", "model.md"}
 
 # Development history and references outside the repository, which the docs must not contain.
-HISTORY_WORDING = re.compile(r"session \d|issue #|issue \d|DESIGN\.md|\.\./shared", re.IGNORECASE)
+HISTORY_WORDING = re.compile(r"\bsession \d|\bissue #|\bissue \d|DESIGN\.md|\.\./shared", re.IGNORECASE)
 
 FENCED_CODE = re.compile(r"^(```|~~~).*?^\1", re.MULTILINE | re.DOTALL)
 INLINE_CODE = re.compile(r"`[^`\n]*`")

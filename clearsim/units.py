@@ -1,8 +1,10 @@
 """Unit strings ("0.01 mm", "5000 rpm", "30 deg") to SI floats, once, at load time.
 
-A bare number is taken as SI (metre, kilogram, second, radian). Angles are
-dimensionless in SI, so "30 deg" and "0.52" are both accepted where an angle is
-expected, and "5000 rpm" converts to rad/s.
+In a mechanism file a bare number on a dimensional key means what the file's `units:` block declares
+(UnitSystem); a file that declares none must write every non-zero dimensional value with its unit. The
+validation context {"units": UnitSystem | None} carries that choice into the schema's quantity types;
+without a context (Python code building a Mechanism) a bare number is SI (metre, kilogram, second,
+radian, newton). Angles are dimensionless in SI, so "5000 rpm" converts to rad/s.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import BeforeValidator, WithJsonSchema
+from pydantic import BeforeValidator, ValidationInfo, WithJsonSchema
 
 
 class UnitError(ValueError):
@@ -95,12 +97,28 @@ DIMENSIONS = {
 }
 
 
+BASE_UNITS = {"length": "m", "mass": "kg", "time": "s", "angle": "rad", "force": "N"}  # a `units:` block's base kinds
+DERIVED_UNITS = {  # the other kinds, built from the base ones unless the block names them too
+    "speed": "{length}/{time}",
+    "acceleration": "{length}/{time}^2",
+    "angular_speed": "{angle}/{time}",
+    "frequency": "1/{time}",
+    "inertia": "{mass}*{length}^2",
+    "torque": "{force}*{length}",
+    "pressure": "{force}/{length}^2",
+    "spring_stiffness": "{force}/{length}",
+    "damping": "{force}*{time}/{length}",
+}
+CONTACT_STIFFNESS_UNIT = "{force}/{length}^{exponent:g}"  # K of F = K δⁿ
+
+
 def _dimensionality(quantity) -> tuple[tuple[str, float], ...]:
     return tuple(sorted((k, float(v)) for k, v in dict(quantity.dimensionality).items() if v))
 
 
 def parse_quantity(value: Any):
-    """A pint quantity from a number or a "value unit" string; UnitError names what is wrong."""
+    """A pint quantity from a number or a "value unit" string; UnitError names what is wrong (a unit with no
+    number, 'kg', is not 1 kg)."""
     if isinstance(value, bool):
         raise UnitError(f"expected a number with a unit, got {value!r}")
     if isinstance(value, (int, float)):
@@ -108,6 +126,7 @@ def parse_quantity(value: Any):
     if not isinstance(value, str):
         raise UnitError(f"expected a number or a 'value unit' string, got {value!r}")
     pint = _import_pint()
+    _number_first(value)
     _one_number(value)
     try:
         quantity = registry().Quantity(value.strip())
@@ -122,6 +141,16 @@ def parse_quantity(value: Any):
 
 
 LEADING_NUMBER = re.compile(r"\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+NOT_FINITE = re.compile(r"\s*[-+]?(?:nan|inf)", re.IGNORECASE)  # left to the finiteness check
+
+
+def _number_first(value: str) -> None:
+    """A value starts with its number: pint reads a unit alone ('kg') as 1 kg, which no one writing it means."""
+    if LEADING_NUMBER.match(value) or NOT_FINITE.match(value):
+        return
+    unit = value.strip()
+    raise UnitError(f"expected a number with a unit, got {value!r}: a unit alone is no value; write the number "
+                    f"before it, e.g. '1 {unit}'" if unit else "expected a number with a unit, got an empty text")
 
 
 def _one_number(value: str) -> None:
@@ -207,9 +236,116 @@ def unit_name(value: str) -> str:
     return value
 
 
+# --- what bare numbers mean: a file's `units:` block -----------------------------------------------
+
+
+@dataclass(frozen=True)
+class UnitSystem:
+    """The unit of every kind that a bare number of a mechanism file is read in; SI for kinds not declared."""
+
+    units: tuple[tuple[str, str], ...]  # (kind, unit) for every kind of BASE_UNITS and DERIVED_UNITS
+
+    def unit(self, kind: str) -> str:
+        return dict(self.units)[kind]
+
+    def to_si(self, number: float, kind: str) -> float:
+        return _check_finite(number * _si_factor(self.unit(kind), kind), number)
+
+    def contact_stiffness_unit(self, exponent: float) -> str:
+        return CONTACT_STIFFNESS_UNIT.format(force=self.unit("force"), length=self.unit("length"), exponent=exponent)
+
+
+def unit_system(declared: dict[str, str]) -> UnitSystem:
+    """The units of a `units:` block (kind → unit, already checked by declared_unit); kinds left out are SI for
+    the base kinds and built from the base units for the derived ones."""
+    base = {kind: declared.get(kind, si) for kind, si in BASE_UNITS.items()}
+    derived = {kind: declared.get(kind, _grouped(formula, base)) for kind, formula in DERIVED_UNITS.items()}
+    return UnitSystem(tuple({**base, **derived}.items()))
+
+
+def _grouped(formula: str, base: dict[str, str]) -> str:
+    return formula.format(**{kind: f"({unit})" if re.search(r"[*/^ ]", unit) else unit for kind, unit in base.items()})
+
+
+SI = unit_system({})
+
+
+@lru_cache(maxsize=256)
+def _si_factor(unit: str, kind: str) -> float:
+    return to_si(f"1 {unit}", kind)
+
+
+def declared_unit(unit: Any, kind: str) -> str:
+    """A unit of a `units:` block, checked to be a unit alone of `kind`; ValueError names what is wrong."""
+    if not isinstance(unit, str):
+        raise ValueError(f"expected a unit such as '{_example_unit(kind)}', got {unit!r}")
+    unit_name(unit)
+    try:
+        to_si(f"1 {unit}", kind)
+    except UnitError:
+        raise ValueError(f"'{unit}' is not a unit of {DIMENSIONS[kind].name} (e.g. '{_example_unit(kind)}', "
+                         f"SI '{DIMENSIONS[kind].si_unit}')") from None
+    return unit
+
+
+def _example_unit(kind: str) -> str:
+    return DIMENSIONS[kind].example.split(" ", 1)[1]
+
+
+UNITS_CONTEXT = "units"  # the validation context's key: a UnitSystem, or None for a file that declares none
+
+
+def bare_to_si(number: float, kind: str, context: dict | None) -> float:
+    """A bare number of kind `kind`: in the declared units; SI without a context (Python code); an error in a
+    file that declares none, unless it is 0 (0 is 0 in every unit)."""
+    if context is None or UNITS_CONTEXT not in context:
+        return to_si(number, kind)
+    system = context[UNITS_CONTEXT]
+    if system is not None:
+        return system.to_si(_check_finite(number, number), kind)
+    if _check_finite(number, number) == 0.0:
+        return 0.0
+    raise UnitError(bare_number_message(number, kind))
+
+
+def declares_no_units(context: dict | None) -> bool:
+    """True while validating a file that has no `units:` block (no context: Python code, SI)."""
+    return context is not None and UNITS_CONTEXT in context and context[UNITS_CONTEXT] is None
+
+
+def declared_system(context: dict | None) -> UnitSystem | None:
+    """The declared units of the file being validated, None when it declares none or for Python code."""
+    return context.get(UNITS_CONTEXT) if context is not None else None
+
+
+def bare_number_message(number: float, kind: str, examples: tuple[str, ...] = (), block: str | None = None) -> str:
+    """The error of a bare number of kind `kind` in a file without `units:`: write the unit (one of `examples`,
+    default the kind's usual and SI units), or declare the file's units (`block`, default {kind: unit})."""
+    examples = examples or tuple(dict.fromkeys((_example_unit(kind), DIMENSIONS[kind].si_unit)))
+    shown = " or ".join(f"'{number:g} {unit}'" for unit in examples)
+    block = block or f"{{{kind}: {examples[0]}}}"
+    return (f"the bare number {number:g} has no unit and this file declares none: write {shown}, or declare what "
+            f"the file's bare numbers mean, e.g. `units: {block}` or `units: SI` at its top")
+
+
+def bare_number(value: Any) -> float | None:
+    """The number a value is when it is a number alone: 10, or text such as '1e-2' (YAML 1.1 reads a number with an
+    exponent and no dot as text) or '10'; None for a value with a unit, a word or a boolean."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)):
+        return value
+    if isinstance(value, str) and LEADING_NUMBER.fullmatch(value.strip()):
+        return float(value)
+    return None
+
+
 def _si_validator(kind: str):
-    def convert(value: Any) -> float:
+    def convert(value: Any, info: ValidationInfo) -> float:
+        number = bare_number(value) if kind != "dimensionless" else None
         try:
+            if number is not None:
+                return bare_to_si(number, kind, info.context)
             return to_si(value, kind)
         except UnitError as exc:
             raise ValueError(str(exc)) from None
@@ -225,7 +361,8 @@ def _quantity_type(kind: str):
         WithJsonSchema(
             {
                 "anyOf": [{"type": "number"}, {"type": "string"}],
-                "description": f"{dimension.name}: a number in {dimension.si_unit} or a string with a unit, e.g. '{dimension.example}'",
+                "description": f"{dimension.name}: a string with a unit, e.g. '{dimension.example}', or a number in "
+                               f"the file's `units:` ({dimension.si_unit} for `units: SI`)",
                 "examples": [dimension.example],  # kept when a field's own description replaces the text above
                 "x-unit": dimension.si_unit,
             }

@@ -28,7 +28,7 @@ from clearsim.model.messages import validation_problems
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.paths import locate_error
 from clearsim.model.references import KINDS, check_references
-from clearsim.model.schema import Mechanism
+from clearsim.model.schema import Mechanism, validate_mechanism
 
 MERGE_TAG = "tag:yaml.org,2002:merge"
 FAST_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when PyYAML has it: ~9× faster
@@ -427,7 +427,7 @@ def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[s
         raise InputError(problems + booleans, name, source)
     mechanism = None
     try:
-        mechanism = Mechanism.model_validate(document)
+        mechanism = validate_mechanism(document)
         problems += check_references(mechanism)
     except ValidationError as exc:
         problems += validation_problems(exc, document, Mechanism) + _references_of_valid_part(document, exc)

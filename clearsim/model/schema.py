@@ -1,7 +1,8 @@
 """The YAML mechanism file as pydantic models: names, SI floats, no arrays.
 
-Every value with a physical kind is converted to SI here (see clearsim.units);
-unknown keys are errors (extra="forbid"). Cross-references between names
+Every value with a physical kind is converted to SI here (see clearsim.units): a
+string by its unit, a bare number by the file's `units:` block (validate_mechanism;
+an error, unless 0, in a file without one); unknown keys are errors (extra="forbid"). Cross-references between names
 (bodies, points, joints, sensors) are checked in clearsim.model.references so
 that all problems of a file are reported together, each with its location.
 """
@@ -11,9 +12,14 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, ValidationInfo, \
+    field_validator, model_validator
 
 from clearsim.units import (
+    BASE_UNITS,
+    DERIVED_UNITS,
+    SI,
+    UNITS_CONTEXT,
     Acceleration,
     Angle,
     AngularSpeed,
@@ -29,11 +35,37 @@ from clearsim.units import (
     Time,
     Torque,
     UnitError,
+    UnitSystem,
+    bare_number,
+    bare_number_message,
+    declared_system,
+    declared_unit,
+    declares_no_units,
     parse_quantity,
     unit_name,
+    unit_system,
 )
 
 RawQuantity = Union[float, str]  # converted where its kind is known (a driver's stroke: m or rad)
+
+
+def _needs_unit(kind: str, examples: tuple[str, ...], block: str | None = None):
+    """A RawQuantity whose bare number, other than 0, is an error in a file that declares no units."""
+    def check(value: RawQuantity, info: ValidationInfo) -> RawQuantity:
+        number = bare_number(value)
+        if number is not None and number != 0 and declares_no_units(info.context):
+            raise ValueError(bare_number_message(number, kind, examples, block))
+        return value
+
+    return AfterValidator(check)
+
+
+def _coefficients_need_units(values: list[float], info: ValidationInfo) -> list[float]:
+    if any(values) and declares_no_units(info.context):
+        raise ValueError("polynomial coefficients are bare numbers in the file's units (m or rad and s for SI), "
+                         "and this file declares none: declare them at its top, e.g. `units: SI` or "
+                         "`units: {length: mm, time: ms}`")
+    return values
 Point = tuple[Length, Length]
 Direction = tuple[float, float]
 PointRef = Union[str, Point]  # a named point, or [x, y]
@@ -64,9 +96,9 @@ class ContactSpec(Strict):
     law: Literal["lankarani_nikravesh", "hertz", "hunt_crossley", "flores"] | None = Field(None, description="contact force law (docs/model.md §3)")
     restitution: float | None = Field(None, gt=0.0, le=1.0, description="coefficient of restitution c_e, 0 < c_e <= 1")
     exponent: float | None = Field(None, gt=0.0, le=3.0, description="force exponent n (1.5 for metals)")
-    stiffness: RawQuantity | None = Field(
-        None, description="K in N/m^n, or 'auto' to compute it from the radii and materials"
-    )
+    stiffness: Annotated[RawQuantity, _needs_unit("force", ("N/m^1.5", "N/mm^1.5"), "{length: mm, force: N}")] | None = Field(
+        None, description="K in N/m^n (a bare number: force/length^n in the file's units), or 'auto' to compute it "
+        "from the radii and materials")
     min_impact_speed: Speed | None = Field(
         None, gt=0.0, description="floor on the impact speed δ̇⁻ in the damping term (grazing guard)"
     )
@@ -167,21 +199,24 @@ class StrokeMotion(Strict):
     """Meng 2015 eq. 16 generalised: s(t) = S τ²(3 − 2τ), τ = (t − t0)/T, held at S after."""
 
     law: Literal["stroke"] = Field(description="motion law")
-    stroke: RawQuantity = Field(description="total stroke S: length (m) or angle (rad) by the driven coordinate")
+    stroke: Annotated[RawQuantity, _needs_unit("length", ("m", "mm", "deg"))] = Field(
+        description="total stroke S: a length or an angle by the driven coordinate")
     duration: Time = Field(gt=0.0, description="stroke time T")
     start: Time = Field(0.0, description="time t0 at which the stroke begins")
 
 
 class ConstantSpeedMotion(Strict):
     law: Literal["constant_speed"] = Field(description="motion law")
-    speed: RawQuantity = Field(description="constant rate: m/s or rad/s by the driven coordinate")
+    speed: Annotated[RawQuantity, _needs_unit("angular_speed", ("rpm", "rad/s", "m/s"))] = Field(
+        description="constant rate: a speed or an angular speed by the driven coordinate")
 
 
 class PolynomialMotion(Strict):
-    """s(t) = Σ_k c_k t^k, k = 1, 2, …, in SI units of the driven coordinate."""
+    """s(t) = Σ_k c_k t^k, k = 1, 2, …, in the file's units of the driven coordinate and of time."""
 
     law: Literal["polynomial"] = Field(description="motion law")
-    coefficients: list[float] = Field(min_length=1, description="[c_1, c_2, …] of s = Σ c_k t^k, SI, at most 7")
+    coefficients: Annotated[list[float], AfterValidator(_coefficients_need_units)] = Field(
+        min_length=1, description="[c_1, c_2, …] of s = Σ c_k t^k in the file's units (length or angle, time), at most 7")
 
 
 class TableMotion(Strict):
@@ -368,6 +403,99 @@ class Tolerance(Strict):
         return self
 
 
+# --- what bare numbers mean -----------------------------------------------------------------------
+
+
+def _unit_of(kind: str):
+    return Annotated[str, BeforeValidator(lambda unit: declared_unit(unit, kind))]
+
+
+def _unit_field(kind: str):
+    default = BASE_UNITS.get(kind) or DERIVED_UNITS[kind].replace("{", "").replace("}", "")
+    return Field(None, description=f"unit of a bare {kind.replace('_', ' ')}; default {default}")
+
+
+class Units(Strict):
+    """`units:`: what the file's bare numbers mean (`units: SI` for every kind in SI). The base kinds not named
+    are SI; the derived ones are built from the base units unless named too."""
+
+    length: _unit_of("length") | None = _unit_field("length")
+    mass: _unit_of("mass") | None = _unit_field("mass")
+    time: _unit_of("time") | None = _unit_field("time")
+    angle: _unit_of("angle") | None = _unit_field("angle")
+    force: _unit_of("force") | None = _unit_field("force")
+    speed: _unit_of("speed") | None = _unit_field("speed")
+    acceleration: _unit_of("acceleration") | None = _unit_field("acceleration")
+    angular_speed: _unit_of("angular_speed") | None = _unit_field("angular_speed")
+    frequency: _unit_of("frequency") | None = _unit_field("frequency")
+    inertia: _unit_of("inertia") | None = _unit_field("inertia")
+    torque: _unit_of("torque") | None = _unit_field("torque")
+    pressure: _unit_of("pressure") | None = _unit_field("pressure")
+    spring_stiffness: _unit_of("spring_stiffness") | None = _unit_field("spring_stiffness")
+    damping: _unit_of("damping") | None = _unit_field("damping")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _si_shorthand(cls, data):
+        if isinstance(data, str):
+            if data.strip().upper() == "SI":
+                return {}
+            raise ValueError(f"expected `SI` or a mapping of kinds to units such as {{length: mm, time: ms}}, "
+                             f"got {data!r}")
+        return data
+
+    def system(self) -> UnitSystem:
+        return unit_system(self.model_dump(exclude_none=True))
+
+
+def declared_units(document) -> UnitSystem | None:
+    """The units a document's `units:` block declares; None when it has none. An invalid block is reported by
+    the validation of the file, whose bare numbers are then read as SI rather than each reported again."""
+    written = document.get("units") if isinstance(document, dict) else None
+    if written is None:
+        return None
+    try:
+        return Units.model_validate(written).system()
+    except ValidationError:
+        return SI
+
+
+def validate_mechanism(document) -> "Mechanism":
+    """A mechanism document validated with its bare numbers read in its declared units (pydantic's
+    ValidationError lists every problem)."""
+    return Mechanism.model_validate(document, context={UNITS_CONTEXT: declared_units(document)})
+
+
+def driven_kind(driver: "Driver", joints) -> str | None:
+    """'length' or 'angle': the kind of the coordinate a driver moves (None: a joint that does not exist)."""
+    if driver.joint is None:
+        return "angle" if driver.coordinate == "angle" else "length"
+    joint = next((j for j in joints if j.name == driver.joint), None)
+    return None if joint is None else ("length" if joint.type == "prismatic" else "angle")
+
+
+def _with_unit(value: RawQuantity | None, unit: str) -> RawQuantity | None:
+    """A bare number as text in `unit`; text with its own unit, a word ('auto') and None unchanged."""
+    number = bare_number(value)
+    return f"{number!r} {unit}" if number is not None else value
+
+
+def _motion_in_units(motion, kind: str, system: UnitSystem) -> None:
+    rate_kind = "speed" if kind == "length" else "angular_speed"
+    if isinstance(motion, StrokeMotion):
+        motion.stroke = _with_unit(motion.stroke, system.unit(kind))
+    elif isinstance(motion, ConstantSpeedMotion):
+        motion.speed = _with_unit(motion.speed, system.unit(rate_kind))
+    elif isinstance(motion, PolynomialMotion):
+        second = system.to_si(1.0, "time")
+        motion.coefficients = [system.to_si(c, kind) / second ** k for k, c in enumerate(motion.coefficients, 1)]
+
+
+def _contact_in_units(contact: ContactSpec | None, exponent: float, system: UnitSystem) -> None:
+    if contact is not None:
+        contact.stiffness = _with_unit(contact.stiffness, system.contact_stiffness_unit(exponent))
+
+
 # --- the file -------------------------------------------------------------------------------------
 
 
@@ -376,6 +504,8 @@ class Mechanism(Strict):
 
     name: str = Field("mechanism", description="title of the mechanism, shown in summaries and result files")
     description: str | None = Field(None, description="free text about the model")
+    units: Units | None = Field(None, description="what bare numbers mean: `SI`, or units by kind such as "
+                                "{length: mm, time: ms}; without it every non-zero dimensional value needs its unit")
     gravity: tuple[Acceleration, Acceleration] = Field((0.0, 0.0), description="gravitational acceleration [g_x, g_y], global frame; default no gravity")
     defaults: Defaults = Defaults()
     points: dict[str, Point] = Field(default_factory=dict, description="named global points at t = 0")
@@ -388,6 +518,24 @@ class Mechanism(Strict):
     solver: SolverSettings
     tolerances: list[Tolerance] = Field(
         default_factory=list, description="random distributions of values for `clearsim sweep --sample N`; ignored by `run`")
+
+    @model_validator(mode="after")
+    def _raw_quantities_in_declared_units(self, info: ValidationInfo):
+        """Bare strokes, speeds, polynomial coefficients and contact stiffnesses, whose kind depends on the driven
+        coordinate or the contact exponent, in the declared units (as text with the unit, or SI coefficients)."""
+        system = declared_system(info.context)
+        if system is None:
+            return self
+        for driver in self.drivers:
+            kind = driven_kind(driver, self.joints)
+            if kind is not None:
+                _motion_in_units(driver.motion, kind, system)
+        exponent = self.defaults.contact.exponent or DEFAULT_CONTACT.exponent
+        _contact_in_units(self.defaults.contact, exponent, system)
+        for joint in self.joints:
+            if isinstance(joint, RevoluteJoint) and joint.contact is not None:
+                _contact_in_units(joint.contact, joint.contact.exponent or exponent, system)
+        return self
 
     def body(self, name: str) -> Body:
         return next(b for b in self.bodies if b.name == name)

@@ -127,6 +127,15 @@ def _summary_table(report, summary) -> Table:
     return table
 
 
+def _print_plausibility_warnings(loaded) -> None:
+    """Values of the file that are valid but look like a misread unit (clearsim.model.plausibility)."""
+    from clearsim.model.plausibility import plausibility_warnings, warning_text
+
+    for problem in plausibility_warnings(loaded.mechanism):
+        errors.print(f"[bold yellow]warning:[/] {escape(warning_text([problem], loaded))}", markup=True,
+                     highlight=False, soft_wrap=True)
+
+
 @app.command()
 @user_errors
 def run(
@@ -141,6 +150,7 @@ def run(
 
     check_output_path(output, config or BUNDLED_CONFIG)
     loaded = load_mechanism(config or BUNDLED_CONFIG, overrides)
+    _print_plausibility_warnings(loaded)
     _announce_compile()
     system = prepare(loaded)
     progress, update = _progress_bar(system.mechanism.solver.t_end)
@@ -221,6 +231,7 @@ def validate(config: Optional[Path] = ConfigArgument, overrides: List[str] = Set
     from clearsim.model.loader import load_mechanism
 
     loaded = load_mechanism(config or BUNDLED_CONFIG, overrides)
+    _print_plausibility_warnings(loaded)
     system = prepare(loaded)
     mechanism = system.mechanism
     console.print(f"{loaded.path}: OK — {len(mechanism.bodies)} bodies, {len(mechanism.joints)} joints, "

@@ -233,7 +233,7 @@ def _stiffness(contact: dict, origin: dict, bearing: float, journal: float, mate
         if not math.isclose(exponent, AUTO_STIFFNESS_EXPONENT):
             raise _error_at(origin, "exponent", f"`stiffness: auto` is the Hertz value for exponent 1.5, "
                             f"not {exponent:g}", f"give the stiffness in N/m^{exponent:g}", "contact")
-        return _auto_stiffness(bearing, journal, material)
+        return auto_stiffness(bearing, journal, material)
     try:
         stiffness = contact_stiffness_to_si(value, exponent)
     except UnitError as exc:
@@ -243,7 +243,7 @@ def _stiffness(contact: dict, origin: dict, bearing: float, journal: float, mate
     return stiffness
 
 
-def _auto_stiffness(bearing: float, journal: float, material) -> float:
+def auto_stiffness(bearing: float, journal: float, material) -> float:
     """K of a journal in a bearing of the same material (clearsim.physics.contact, DESIGN.md §4)."""
     from clearsim.physics.contact import internal_contact_stiffness
 

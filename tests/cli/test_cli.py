@@ -127,7 +127,7 @@ def test_bad_mechanisms_give_one_located_message_and_exit_2(tmp_path, text, expe
 
 
 @pytest.mark.parametrize("override, place", [
-    ("drivers.crank_drive.motion={law: stroke, stroke: 1, duration: 1e-300 s}", "drivers[0] 'crank_drive' → motion"),
+    ("drivers.crank_drive.motion={law: stroke, stroke: 1 rad, duration: 1e-300 s}", "drivers[0] 'crank_drive' → motion"),
     ("drivers.crank_drive.lag=1e300 s", "drivers[0] 'crank_drive' → lag"),
 ], ids=["stroke", "lag"])
 def test_a_motion_beyond_floating_point_exits_2_at_its_driver(override, place):

@@ -145,12 +145,18 @@ NOT_FINITE = re.compile(r"\s*[-+]?(?:nan|inf)", re.IGNORECASE)  # left to the fi
 
 
 def _number_first(value: str) -> None:
-    """A value starts with its number: pint reads a unit alone ('kg') as 1 kg, which no one writing it means."""
+    """A unit alone is no value: pint reads 'kg' as 1 kg, which no one writing it means."""
+    unit = value.strip()
+    if not unit:
+        raise UnitError("expected a number with a unit, got an empty text")
     if LEADING_NUMBER.match(value) or NOT_FINITE.match(value):
         return
-    unit = value.strip()
+    try:
+        registry().parse_units(unit)
+    except Exception:  # noqa: BLE001 — not a unit alone: pint's own reading and message follow
+        return
     raise UnitError(f"expected a number with a unit, got {value!r}: a unit alone is no value; write the number "
-                    f"before it, e.g. '1 {unit}'" if unit else "expected a number with a unit, got an empty text")
+                    f"before it, e.g. '1 {unit}'")
 
 
 def _one_number(value: str) -> None:
@@ -328,16 +334,28 @@ def bare_number_message(number: float, kind: str, examples: tuple[str, ...] = ()
             f"the file's bare numbers mean, e.g. `units: {block}` or `units: SI` at its top")
 
 
+def si_text(value: float, kind: str) -> str:
+    """An SI value as text with its SI unit ('1e-05 m'): what code writes into a mechanism document, read the same
+    whatever the file's `units:` declare."""
+    return f"{float(value)!r} {DIMENSIONS[kind].si_unit}"
+
+
 def bare_number(value: Any) -> float | None:
-    """The number a value is when it is a number alone: 10, or text such as '1e-2' (YAML 1.1 reads a number with an
-    exponent and no dot as text) or '10'; None for a value with a unit, a word or a boolean."""
+    """The number a value is when it has no unit: 10, or text such as '1e-2' (YAML 1.1 reads a number with an
+    exponent and no dot as text), '10' or '(0.005)'; None for a value with a unit, a word or a boolean."""
     if isinstance(value, bool):
         return None
     if isinstance(value, (int, float)):
         return value
-    if isinstance(value, str) and LEADING_NUMBER.fullmatch(value.strip()):
+    if not isinstance(value, str) or re.search(r"[^\W\deE_]", value):  # a letter: a unit, or a word such as auto
+        return None
+    if LEADING_NUMBER.fullmatch(value.strip()):
         return float(value)
-    return None
+    try:
+        quantity = parse_quantity(value)
+    except UnitError:
+        return None
+    return None if _has_unit(quantity) else float(quantity.magnitude)
 
 
 def _si_validator(kind: str):

@@ -26,7 +26,7 @@ from clearsim.model.loader import load_mechanism_text
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.resolve import is_clearance_joint, resolve_clearance
 from clearsim.model.schema import Mechanism, PrismaticJoint, SpringDamper, StrokeMotion
-from clearsim.units import to_si
+from clearsim.units import si_text, to_si
 
 FAR_ANCHOR = 1000.0  # m: a damper anchored this far along its line acts in a fixed direction
 
@@ -135,8 +135,8 @@ def clearance(mechanism, document) -> list[Candidate]:
 
         def write(doc, value, name=joint.name, add_radius=radius_missing):
             if add_radius:
-                _set(doc, f"joints.{name}.bearing_radius", DEFAULT_BEARING_RADIUS)
-            _set(doc, f"joints.{name}.clearance", value)
+                _set(doc, f"joints.{name}.bearing_radius", si_text(DEFAULT_BEARING_RADIUS, "length"))
+            _set(doc, f"joints.{name}.clearance", si_text(value, "length"))
 
         out.append(Candidate("clearance", joint.name, "clearance", "m", *CLEARANCE_BOUNDS, True, current, write,
                              ("mm", 1e-3)))
@@ -168,11 +168,12 @@ def friction(mechanism, document) -> list[Candidate]:
         def write(doc, value, name=joint.name, law=law, ratio=ratio, extra=spec.get(law, {}), pin=pin,
                   add_radius=radius_missing):
             if add_radius:
-                _set(doc, f"joints.{name}.bearing_radius", DEFAULT_BEARING_RADIUS)
+                _set(doc, f"joints.{name}.bearing_radius", si_text(DEFAULT_BEARING_RADIUS, "length"))
             if pin:
-                _set(doc, f"joints.{name}.clearance", PIN_CLEARANCE)
-            numbers = {"mu_d": value, **({"mu_s": value * ratio} if law == "stiction_step" else {}), **extra}
-            body = ", ".join(f"{k}: {v!r}" for k, v in numbers.items())
+                _set(doc, f"joints.{name}.clearance", si_text(PIN_CLEARANCE, "length"))
+            numbers = {"mu_d": repr(value), **({"mu_s": repr(value * ratio)} if law == "stiction_step" else {}),
+                       **{key: si_text(speed, "speed") for key, speed in extra.items()}}
+            body = ", ".join(f"{k}: {v}" for k, v in numbers.items())
             _set(doc, f"joints.{name}.friction", f"{{law: {law}, {body}}}")
 
         current = None if pin or p.friction_law == "none" else p.mu_d
@@ -182,13 +183,16 @@ def friction(mechanism, document) -> list[Candidate]:
 
 
 def _contact_candidates(mechanism, kind: str, key: str, unit: str, bounds, logarithmic: bool) -> list[Candidate]:
-    """One candidate per clearance joint for a key of its `contact:` block; bounds(present) → (low, high)."""
+    """One candidate per clearance joint for a key of its `contact:` block; bounds(present) → (low, high).
+    A unit ending in ^n is the contact exponent's."""
     out = []
     for joint in _clearance_joints(mechanism):
-        present = getattr(resolve_clearance(joint, mechanism.defaults), key)
+        parameters = resolve_clearance(joint, mechanism.defaults)
+        present = getattr(parameters, key)
+        written_unit = unit.replace("^n", f"^{parameters.exponent:g}")
 
-        def write(doc, value, name=joint.name):
-            _set(doc, f"joints.{name}.contact.{key}", value)
+        def write(doc, value, name=joint.name, written_unit=written_unit):
+            _set(doc, f"joints.{name}.contact.{key}", f"{value!r} {written_unit}".strip())
 
         out.append(Candidate(kind, joint.name, key, unit, *bounds(present), logarithmic, present, write))
     return out
@@ -213,7 +217,7 @@ def drive(mechanism, document) -> list[Candidate]:
     out = []
     for driver in mechanism.drivers:
         def write_lag(doc, value, name=driver.name):
-            _set(doc, f"drivers.{name}.lag", value)
+            _set(doc, f"drivers.{name}.lag", si_text(value, "time"))
 
         out.append(Candidate("drive", driver.name, "lag", "s", *LAG_BOUNDS, True, driver.lag or None, write_lag,
                              ("ms", 1e-3)))
@@ -222,7 +226,7 @@ def drive(mechanism, document) -> list[Candidate]:
 
             def write_stroke(doc, value, name=driver.name, written=written):
                 kind = "length" if not str(written).strip().endswith(("deg", "rad")) else "angle"
-                _set(doc, f"drivers.{name}.motion.stroke", to_si(written, kind) * value)
+                _set(doc, f"drivers.{name}.motion.stroke", si_text(to_si(written, kind) * value, kind))
 
             out.append(Candidate("drive", driver.name, "stroke factor", "", *STROKE_FACTOR_BOUNDS, False, 1.0,
                                  write_stroke))
@@ -246,7 +250,7 @@ def damping(mechanism, document) -> list[Candidate]:
         forces = doc.setdefault("forces", []) or []
         doc["forces"] = [f for f in forces if f.get("name") != "diagnose_damping"] + [{
             "type": "spring_damper", "name": "diagnose_damping", "bodies": ["ground", body.name],
-            "at": [anchor.tolist(), where.tolist()], "damping": value}]
+            "at": [_point_text(anchor), _point_text(where)], "damping": si_text(value, "damping")}]
 
     return [Candidate("damping", body.name, "damping", "N*s/m", 1e-3 * scale, 10.0 * scale, True, None, write,
                       ("N·s/m", 1.0))]
@@ -260,8 +264,8 @@ def mass(mechanism, document) -> list[Candidate]:
     out = []
     for body in mechanism.bodies:
         def write(doc, value, name=body.name, m0=body.mass, j0=body.inertia):
-            _set(doc, f"bodies.{name}.mass", m0 * value)
-            _set(doc, f"bodies.{name}.inertia", j0 * value)
+            _set(doc, f"bodies.{name}.mass", si_text(m0 * value, "mass"))
+            _set(doc, f"bodies.{name}.inertia", si_text(j0 * value, "inertia"))
 
         out.append(Candidate("mass", body.name, "mass factor", "", *MASS_FACTOR_BOUNDS, True, 1.0, write))
     return out
@@ -288,6 +292,7 @@ class LinkSplit:
     moved_sensors: frozenset  # point sensors nearer the second joint
     moved_ends: dict  # force name → indices of its ends on the body nearer the second joint (single-body force: (0,))
     mass: float  # kg, of the whole link
+    inertia: float  # kg·m², of the whole link
     tension: float = 0.0  # N: the rigid link's axial tension at t = 0, carried by the spring from the start
 
     @property
@@ -353,7 +358,8 @@ def link_split(mechanism, body: str, joints: list) -> LinkSplit | None:
                         and nearer_far(poses.point_global(s.point, poses.index[body], ())))
     moved = {f.name: tuple(end for end, where in _force_ends(poses, f, body) if nearer_far(where)) for f in mechanism.forces}
     split = LinkSplit(body, f"{body}_{joints[1].name}_half", tuple(near.tolist()), tuple(far.tolist()), joints[1].name, sensors,
-                      {name: ends for name, ends in moved.items() if ends}, mechanism.body(body).mass)
+                      {name: ends for name, ends in moved.items() if ends}, mechanism.body(body).mass,
+                      mechanism.body(body).inertia)
     taken = {b.name for b in mechanism.bodies} | {j.name for j in mechanism.joints} | {f.name for f in mechanism.forces}
     return None if {split.half, split.guide, split.spring} & taken else split
 
@@ -363,8 +369,8 @@ def split_link(document: dict, split: LinkSplit) -> None:
     bodies = document["bodies"]
     position = next(i for i, b in enumerate(bodies) if b["name"] == split.body)
     near = bodies[position]
-    near["mass"] = to_si(near["mass"], "mass") / 2.0
-    near["inertia"] = to_si(near["inertia"], "inertia") / 2.0
+    near["mass"] = si_text(split.mass / 2.0, "mass")
+    near["inertia"] = si_text(split.inertia / 2.0, "inertia")
     bodies.insert(position + 1, {**copy.deepcopy(near), "name": split.half})
 
     def moved(names, ends):
@@ -384,10 +390,15 @@ def split_link(document: dict, split: LinkSplit) -> None:
             force["bodies"] = moved(force["bodies"], ends)
     axis = np.subtract(split.far, split.near)
     document["joints"].append({"name": split.guide, "type": "prismatic", "bodies": [split.body, split.half],
-                               "at": list(split.near), "axis": (axis / np.linalg.norm(axis)).tolist()})
+                               "at": _point_text(split.near), "axis": (axis / np.linalg.norm(axis)).tolist()})
     document["forces"] = (document.get("forces") or []) + [{
         "type": "spring_damper", "name": split.spring, "bodies": [split.body, split.half],
-        "at": [list(split.near), list(split.far)], "stiffness": 0.0, "damping": 0.0, "free_length": split.length}]
+        "at": [_point_text(split.near), _point_text(split.far)], "stiffness": 0.0, "damping": 0.0,
+        "free_length": si_text(split.length, "length")}]
+
+
+def _point_text(point) -> list[str]:
+    return [si_text(coordinate, "length") for coordinate in point]
 
 
 def initial_tension(document: dict, split: LinkSplit, base_dir: Path) -> float:
@@ -426,9 +437,9 @@ def compliance(mechanism, document, base_dir: Path = Path(".")) -> list[Candidat
             if spring is None:
                 split_link(doc, split)
                 spring = doc["forces"][-1]
-            spring["stiffness"] = float(value)
-            spring["damping"] = COMPLIANCE_DAMPING_RATIO * float(np.sqrt(value * split.mass))
-            spring["free_length"] = split.length - split.tension / float(value)
+            spring["stiffness"] = si_text(value, "spring_stiffness")
+            spring["damping"] = si_text(COMPLIANCE_DAMPING_RATIO * np.sqrt(value * split.mass), "damping")
+            spring["free_length"] = si_text(split.length - split.tension / float(value), "length")
 
         out.append(Candidate("compliance", body, "stiffness", "N/m", *COMPLIANCE_BOUNDS, True, None, write,
                              ("MN/m", 1e6), resonant=True))

@@ -161,7 +161,7 @@ def test_solver_failure_exits_2_with_time_and_joint_and_keeps_partial_results(tm
 
 def test_solver_failure_without_a_joint_is_placed_at_the_solver_settings(tmp_path):
     out = tmp_path / "failed.h5"
-    result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=1ms", "--set", "bodies.crank.mass=1e300")
+    result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=1ms", "--set", "bodies.crank.mass=1e300 kg")
     assert result.exit_code == 2, result.output
     line = next(number for number, text in enumerate(Path(SLIDER_CRANK).read_text().splitlines(), 1)
                 if text.startswith("solver:"))
@@ -194,7 +194,7 @@ def test_a_run_that_overflows_reports_the_failure_without_numpy_warnings(tmp_pat
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = invoke("run", SLIDER_CRANK, "-o", tmp_path / "overflow.h5", "--set", "solver.t_end=1ms",
-                        "--set", "drivers.crank_drive.motion={law: polynomial, coefficients: [1e300, 1e300]}")
+                        "--set", "units=SI", "--set", "drivers.crank_drive.motion={law: polynomial, coefficients: [1e300, 1e300]}")
     assert result.exit_code == 2, result.output
     assert "at t = 0 ms: the step size fell below solver.min_step" in result.output
     assert [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)] == []

@@ -35,7 +35,7 @@ def four_bar_chain(bars: int, clearance_joints: int, t_end: float = 0.02) -> str
     coupler 0.1 m, rocker arm 0.06 m; the rocker's second arm, opposite, is the next bar's input. The first
     input is a crank at 600 rpm. The last K coupler–rocker pins have clearance 0.1 mm (frictionless).
     """
-    lines = ["name: four-bar chain", "gravity: [0, 0]",
+    lines = ["name: four-bar chain", "units: SI  # the coordinates and masses below are written in m and kg", "gravity: [0, 0]",
              "defaults: {bearing_radius: 5 mm, contact: {law: lankarani_nikravesh, restitution: 0.9, stiffness: auto}, "
              "friction: {law: none}}", "bodies:",
              "  - {name: crank, mass: 0.1, inertia: 1e-5, position: [0.0, 0.015], angle: 90 deg}"]

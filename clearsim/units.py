@@ -283,9 +283,12 @@ def _si_factor(unit: str, kind: str) -> float:
 
 def declared_unit(unit: Any, kind: str) -> str:
     """A unit of a `units:` block, checked to be a unit alone of `kind`; ValueError names what is wrong."""
-    if not isinstance(unit, str):
-        raise ValueError(f"expected a unit such as '{_example_unit(kind)}', got {unit!r}")
-    unit_name(unit)
+    try:
+        if not isinstance(unit, str) or not unit.strip():
+            raise ValueError(unit)
+        unit_name(unit)
+    except ValueError:
+        raise ValueError(f"expected a unit alone, such as '{_example_unit(kind)}', got {unit!r}") from None
     try:
         to_si(f"1 {unit}", kind)
     except UnitError:

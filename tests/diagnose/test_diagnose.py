@@ -180,7 +180,7 @@ def test_a_model_that_does_not_run_to_the_end_is_one_message_and_exit_code_2(tmp
     record = tmp_path / "bench.csv"
     record.write_text("time [ms],slider_displacement [mm]\n" + rows(300))
     # steps no shorter than 20 µs cannot resolve the first impact (0.23 ms): the solver stops the run there
-    result = invoke("diagnose", SLIDER_CRANK, "--set", "solver.min_step=2e-5", "--measured", record,
+    result = invoke("diagnose", SLIDER_CRANK, "--set", "solver.min_step=2e-5 s", "--measured", record,
                     "-o", tmp_path / "report")
     assert result.exit_code == 2, result.output
     text = " ".join(result.output.split())

@@ -114,3 +114,139 @@ def test_a_value_is_one_number_with_a_unit(text):
                                       ("2 kN*m", 2000.0), ("-0.5 mm", -5e-4)])
 def test_units_with_digits_and_products_still_read(text, si):
     assert float(parse_quantity(text).to_base_units().magnitude) == pytest.approx(si, rel=1e-15)
+
+
+# --- a file's `units:` block: what its bare numbers mean ------------------------------------------
+
+from pathlib import Path  # noqa: E402
+
+from clearsim.errors import InputError  # noqa: E402
+from clearsim.model.loader import load_mechanism_text  # noqa: E402
+from clearsim.model.resolve import resolve_clearance  # noqa: E402
+from clearsim.units import SI, unit_system  # noqa: E402
+
+FLORES = (Path(__file__).resolve().parents[2] / "clearsim" / "configs" / "slider_crank_flores.yaml").read_text()
+
+
+def flores(*edits: tuple[str, str], units: str = "") -> str:
+    text = FLORES
+    for old, new in edits:
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
+    return (units + "\n" if units else "") + text
+
+
+def load_error(text: str, *overrides: str) -> str:
+    with pytest.raises(InputError) as info:
+        load_mechanism_text(text, "sc.yaml", overrides=overrides)
+    return str(info.value)
+
+
+@pytest.mark.parametrize("old, new, place, written", [
+    ("bearing_radius: 10 mm", "bearing_radius: 10", "joints[2] 'slider_pin' → bearing_radius", "'10 mm' or '10 m'"),
+    ("speed: 5000 rpm", "speed: 300", "drivers[0] 'crank_drive' → motion → speed", "'300 rpm' or '300 rad/s'"),
+    ("position: [0.11 m, 0 m]", "position: [25, 43.3]", "bodies[1] 'rod' → position[0]", "'25 mm' or '25 m'"),
+    ("stiffness: auto", "stiffness: 1e12", "defaults → contact → stiffness", "'1e+12 N/m^1.5'"),
+    ("t_end: 24 ms", "t_end: 0.024", "solver → t_end", "'0.024 ms' or '0.024 s'"),
+    ("mass: 0.30 kg", "mass: '0.30'", "bodies[0] 'crank' → mass", "'0.3 kg'"),
+], ids=["bearing_radius", "speed", "position", "contact stiffness", "t_end", "quoted number"])
+def test_a_bare_number_on_a_dimensional_key_is_a_located_error_in_a_file_without_units(old, new, place, written):
+    message = load_error(flores((old, new)))
+    assert f"sc.yaml:" in message and place in message
+    assert f"the bare number" in message and f"write {written}" in message and "`units: SI`" in message
+
+
+def test_a_bare_zero_and_dimensionless_keys_need_no_unit():
+    loaded = load_mechanism_text(flores(("position: [0.025 m, 0 m]", "position: [0.025 m, 0]")))
+    assert loaded.mechanism.bodies[0].position == (0.025, 0.0)
+    assert loaded.mechanism.defaults.material.poisson_ratio == 0.3 and loaded.mechanism.defaults.contact.restitution == 0.9
+
+
+def test_polynomial_coefficients_need_declared_units():
+    law = "motion: {law: polynomial, coefficients: [523.6]}"
+    assert "polynomial coefficients" in load_error(flores(("motion: {law: constant_speed, speed: 5000 rpm}", law)))
+    loaded = load_mechanism_text(flores(("motion: {law: constant_speed, speed: 5000 rpm}",
+                                         "motion: {law: polynomial, coefficients: [30, 6]}"),
+                                        units="units: {angle: deg, time: ms}"))
+    coefficients = loaded.mechanism.drivers[0].motion.coefficients  # 30 deg/ms = 523.6 rad/s; 6 deg/ms² = 1.047e5 rad/s²
+    assert coefficients == pytest.approx([30 * math.pi / 180 / 1e-3, 6 * math.pi / 180 / 1e-6], rel=1e-12)
+
+
+def test_a_unit_alone_is_not_a_value():
+    """`mass: kg` was read as 1 kg."""
+    message = load_error(flores(("mass: 0.30 kg", "mass: kg")))
+    assert "bodies[0] 'crank' → mass" in message and "a unit alone" in message and "'1 kg'" in message
+    with pytest.raises(UnitError, match="a unit alone"):
+        to_si("deg", "angle")
+
+
+MILLIMETRE_FILE = [
+    ("position: [0.025 m, 0 m]", "position: [25, 0]"),
+    ("A: [0.05 m, 0 m]", "A: [50, 0]"),
+    ("bearing_radius: 10 mm", "bearing_radius: 10"),
+    ("journal_radius: 9.5 mm", "journal_radius: 9.5"),
+    ("speed: 5000 rpm", "speed: 5000"),
+    ("stiffness: auto", "stiffness: 3.81e7"),
+    ("youngs_modulus: 207 GPa", "youngs_modulus: 207e3"),
+    ("inertia: 0.0001 kg*m^2, position: [0.17 m, 0 m]", "inertia: 100, position: [170, 0]"),
+    ("t_end: 24 ms", "t_end: 24"),
+    ("max_step: 0.1 ms", "max_step: 0.1"),
+]
+
+
+def test_a_units_block_is_honoured_and_every_number_checked_against_its_si_value():
+    text = flores(*MILLIMETRE_FILE, units="units: {length: mm, time: ms, angular_speed: rpm, inertia: kg*mm^2}")
+    mechanism = load_mechanism_text(text).mechanism
+    assert mechanism.bodies[0].position == pytest.approx((0.025, 0.0), rel=1e-12)
+    assert mechanism.points["A"] == pytest.approx((0.05, 0.0), rel=1e-12)
+    assert mechanism.bodies[2].inertia == pytest.approx(1e-4, rel=1e-12)  # 100 kg*mm^2
+    assert mechanism.defaults.material.youngs_modulus == pytest.approx(207e9, rel=1e-12)  # 207e3 N/mm^2
+    assert mechanism.solver.t_end == pytest.approx(0.024, rel=1e-12) and mechanism.solver.max_step == pytest.approx(1e-4)
+    assert to_si(mechanism.drivers[0].motion.speed, "angular_speed") == pytest.approx(523.5987756, rel=1e-9)
+    clearance = resolve_clearance(mechanism.joint("slider_pin"), mechanism.defaults)
+    assert (clearance.bearing_radius, clearance.clearance) == pytest.approx((0.01, 0.0005), rel=1e-12)
+    assert clearance.stiffness == pytest.approx(3.81e7 * 1000 ** 1.5, rel=1e-12)  # N/mm^1.5, Meng 2015 Table 2
+    si = load_mechanism_text(FLORES).mechanism
+    assert mechanism.bodies[0].mass == si.bodies[0].mass and mechanism.solver.output_rate == si.solver.output_rate
+
+
+def test_units_si_is_the_explicit_shorthand_and_derived_kinds_follow_the_base_ones():
+    mechanism = load_mechanism_text(flores(("bearing_radius: 10 mm", "bearing_radius: 0.01"), units="units: SI")).mechanism
+    assert mechanism.joint("slider_pin").bearing_radius == 0.01
+    system = unit_system({"length": "mm", "time": "ms", "force": "kN"})
+    assert system.to_si(1.0, "speed") == pytest.approx(1.0)  # mm/ms
+    assert system.to_si(1.0, "acceleration") == pytest.approx(1e3)  # mm/ms²
+    assert system.to_si(1.0, "pressure") == pytest.approx(1e9)  # kN/mm²
+    assert system.to_si(1.0, "spring_stiffness") == pytest.approx(1e6)  # kN/mm
+    assert system.to_si(1.0, "torque") == pytest.approx(1.0)  # kN·mm
+    assert system.to_si(1.0, "frequency") == pytest.approx(1e3)  # 1/ms
+    assert unit_system({"speed": "km/h"}).to_si(36.0, "speed") == pytest.approx(10.0)  # a derived kind named itself
+    assert all(SI.to_si(1.0, kind) == 1.0 for kind, _ in SI.units)
+
+
+@pytest.mark.parametrize("block, message", [
+    ("units: {lenght: mm}", "unknown key 'lenght'; did you mean 'length'?"),
+    ("units: {time: kg}", "'kg' is not a unit of time"),
+    ("units: {length: 2 mm}", "expected a unit alone, such as 'mm', got '2 mm'"),
+    ("units: imperial", "expected `SI` or a mapping of kinds to units"),
+], ids=["misspelt kind", "wrong kind", "a number in it", "not SI"])
+def test_a_bad_units_block_is_a_located_error(block, message):
+    error = load_error(flores(units=block))
+    assert "sc.yaml:1:" in error and message in error
+
+
+def test_set_bare_numbers_follow_the_declared_units_and_are_an_error_without():
+    error = load_error(FLORES, "joints.slider_pin.clearance=0.1")
+    assert "in --set joints.slider_pin.clearance=0.1" in error and "the bare number 0.1 has no unit" in error
+    declared = flores(units="units: {length: mm}")
+    loaded = load_mechanism_text(declared, overrides=["joints.slider_pin.clearance=0.1"])
+    assert resolve_clearance(loaded.mechanism.joint("slider_pin"), loaded.mechanism.defaults).clearance == pytest.approx(1e-4)
+    with_si = load_mechanism_text(FLORES, overrides=["units=SI", "joints.slider_pin.clearance=1e-4"])
+    assert with_si.mechanism.joint("slider_pin").clearance == pytest.approx(1e-4)
+
+
+def test_the_resolved_yaml_of_a_file_with_units_reloads_identically():
+    text = flores(*MILLIMETRE_FILE, units="units: {length: mm, time: ms, angular_speed: rpm, inertia: kg*mm^2}")
+    loaded = load_mechanism_text(text, overrides=["joints.slider_pin.clearance=0.2"])
+    again = load_mechanism_text(loaded.resolved_yaml)
+    assert again.mechanism == loaded.mechanism

@@ -61,6 +61,7 @@ def test_constant_and_tabulated_forces(simulate, tmp_path):
 
 DRIVEN = """
 name: crank driven by angle, slider driven by a table
+units: SI  # the polynomial coefficients: rad/s and rad/s^2
 points: {O: [0 m, 0 m]}
 bodies:
   - {name: crank, mass: 1 kg, inertia: 0.01 kg*m^2, position: [0 m, 0 m], angle: 30 deg}

@@ -36,7 +36,7 @@ CRANK_BENCH = ["--sensors", "slider_displacement,slider_velocity", "--rate", "50
 UHV_CONTACT = ["--sensors", "contact_displacement,contact_velocity", *UHV_BENCH[2:]]  # the moving contact's sensors
 FRICTION_J = ["--candidates", "friction,clearance,restitution"]
 FRICTIONLESS_UHV = ["defaults.friction={law: none}", "joints.A.clearance=0", "joints.J.clearance=0"]
-AMBROSIO_UHV = ["defaults.friction={law: ambrosio, mu_d: 0.16, v_0: 1e-3, v_1: 1e-2}", "joints.A.clearance=0.1mm",
+AMBROSIO_UHV = ["defaults.friction={law: ambrosio, mu_d: 0.16, v_0: 1e-3 m/s, v_1: 1e-2 m/s}", "joints.A.clearance=0.1mm",
                 "joints.J.clearance=0.1mm", "solver.rtol=1e-6", "solver.output_rate=30kHz"]
 
 

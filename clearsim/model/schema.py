@@ -13,7 +13,7 @@ import math
 from typing import Annotated, Literal, Union
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, ValidationInfo, \
-    field_validator, model_validator
+    WithJsonSchema, field_validator, model_validator
 
 from clearsim.units import (
     BASE_UNITS,
@@ -448,6 +448,10 @@ class Units(Strict):
         return unit_system(self.model_dump(exclude_none=True))
 
 
+UNITS_JSON_SCHEMA = {"anyOf": [{"const": "SI"}, {"type": "object", "additionalProperties": False, "properties": {
+    kind: {"type": "string", "description": field.description} for kind, field in Units.model_fields.items()}}]}
+
+
 def declared_units(document) -> UnitSystem | None:
     """The units a document's `units:` block declares; None when it has none. An invalid block is reported by
     the validation of the file, whose bare numbers are then read as SI rather than each reported again."""
@@ -504,7 +508,7 @@ class Mechanism(Strict):
 
     name: str = Field("mechanism", description="title of the mechanism, shown in summaries and result files")
     description: str | None = Field(None, description="free text about the model")
-    units: Units | None = Field(None, description="what bare numbers mean: `SI`, or units by kind such as "
+    units: Annotated[Units | None, WithJsonSchema(UNITS_JSON_SCHEMA)] = Field(None, description="what bare numbers mean: `SI`, or units by kind such as "
                                 "{length: mm, time: ms}; without it every non-zero dimensional value needs its unit")
     gravity: tuple[Acceleration, Acceleration] = Field((0.0, 0.0), description="gravitational acceleration [g_x, g_y], global frame; default no gravity")
     defaults: Defaults = Defaults()

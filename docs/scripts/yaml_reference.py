@@ -76,7 +76,7 @@ def type_text(annotation: Any) -> str:
     """The type as a reader of the YAML sees it: quantity, string, [x, y], list of a model, ..."""
     bare, metadata = _parts(annotation)
     origin, arguments = typing.get_origin(bare), typing.get_args(bare)
-    if any(isinstance(m, WithJsonSchema) for m in metadata):
+    if any(isinstance(m, WithJsonSchema) and "x-unit" in (m.json_schema or {}) for m in metadata):
         return "quantity"
     if _members(bare):
         return " or ".join(type_text(a) for a in _members(bare))

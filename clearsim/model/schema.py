@@ -2,8 +2,8 @@
 
 Every value with a physical kind is converted to SI here (see clearsim.units): a
 string by its unit, a bare number by the file's `units:` block (validate_mechanism;
-an error, unless 0, in a file without one); unknown keys are errors (extra="forbid"). Cross-references between names
-(bodies, points, joints, sensors) are checked in clearsim.model.references so
+an error, unless 0, in a file without one). Unknown keys are errors (extra="forbid").
+Cross-references between names (bodies, points, joints, sensors) are checked in clearsim.model.references so
 that all problems of a file are reported together, each with its location.
 """
 
@@ -66,6 +66,8 @@ def _coefficients_need_units(values: list[float], info: ValidationInfo) -> list[
                          "and this file declares none: declare them at its top, e.g. `units: SI` or "
                          "`units: {length: mm, time: ms}`")
     return values
+
+
 Point = tuple[Length, Length]
 Direction = tuple[float, float]
 PointRef = Union[str, Point]  # a named point, or [x, y]

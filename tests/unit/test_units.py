@@ -3,6 +3,7 @@
 import math
 
 import pytest
+import yaml
 
 from clearsim.units import UnitError, contact_stiffness_to_si, parse_quantity, to_si
 
@@ -250,3 +251,29 @@ def test_the_resolved_yaml_of_a_file_with_units_reloads_identically():
     loaded = load_mechanism_text(text, overrides=["joints.slider_pin.clearance=0.2"])
     again = load_mechanism_text(loaded.resolved_yaml)
     assert again.mechanism == loaded.mechanism
+
+
+def test_diagnose_writes_si_values_that_a_file_with_declared_units_reads_unchanged():
+    """The candidates wrote bare SI floats into the document: 2e-4 (m) read as 2e-4 mm in a file of millimetres."""
+    from clearsim.diagnose.candidates import candidates_for
+
+    text = flores(("bearing_radius: 10 mm", "bearing_radius: 10"), ("journal_radius: 9.5 mm", "journal_radius: 9.5"),
+                  units="units: {length: mm, time: ms}")
+    loaded = load_mechanism_text(text)
+    candidates = {(c.kind, c.target, c.parameter): c for c in
+                  candidates_for(loaded.mechanism, loaded.document, ["clearance", "drive", "stiffness", "damping", "mass"])}
+
+    def applied(kind, target, parameter, value):
+        document = candidates[kind, target, parameter].applied(loaded.document, value)
+        return load_mechanism_text(yaml.safe_dump(document)).mechanism
+
+    joint = applied("clearance", "slider_pin", "clearance", 2e-4).joint("slider_pin")
+    assert resolve_clearance(joint, loaded.mechanism.defaults).clearance == pytest.approx(2e-4, rel=1e-12)
+    assert applied("drive", "crank_drive", "lag", 2e-3).drivers[0].lag == pytest.approx(2e-3, rel=1e-12)
+    stiff = applied("stiffness", "slider_pin", "stiffness", 3e10)
+    assert resolve_clearance(stiff.joint("slider_pin"), stiff.defaults).stiffness == pytest.approx(3e10, rel=1e-12)
+    damper = applied("damping", "slider", "damping", 5.0).forces[-1]
+    assert damper.damping == pytest.approx(5.0, rel=1e-12)
+    assert abs(damper.at[0][0] - 1000.17) < 1e-9  # the far anchor: 1000 m along the output direction, in metres
+    heavier = applied("mass", "crank", "mass factor", 1.5)
+    assert heavier.bodies[0].mass == pytest.approx(0.45) and heavier.bodies[0].inertia == pytest.approx(1.5e-4)

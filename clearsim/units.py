@@ -331,7 +331,8 @@ def bare_number_message(number: float, kind: str, examples: tuple[str, ...] = ()
     """The error of a bare number of kind `kind` in a file without `units:`: write the unit (one of `examples`,
     default the kind's usual and SI units), or declare the file's units (`block`, default {kind: unit})."""
     examples = examples or tuple(dict.fromkeys((_example_unit(kind), DIMENSIONS[kind].si_unit)))
-    shown = " or ".join(f"'{number:g} {unit}'" for unit in examples)
+    written = [f"'{number:g} {unit}'" for unit in examples]
+    shown = " or ".join([", ".join(written[:-1]), written[-1]] if len(written) > 2 else written)
     block = block or f"{{{kind}: {examples[0]}}}"
     return (f"the bare number {number:g} has no unit and this file declares none: write {shown}, or declare what "
             f"the file's bare numbers mean, e.g. `units: {block}` or `units: SI` at its top")

@@ -145,7 +145,7 @@ def load_error(text: str, *overrides: str) -> str:
 
 @pytest.mark.parametrize("old, new, place, written", [
     ("bearing_radius: 10 mm", "bearing_radius: 10", "joints[2] 'slider_pin' → bearing_radius", "'10 mm' or '10 m'"),
-    ("speed: 5000 rpm", "speed: 300", "drivers[0] 'crank_drive' → motion → speed", "'300 rpm' or '300 rad/s'"),
+    ("speed: 5000 rpm", "speed: 300", "drivers[0] 'crank_drive' → motion → speed", "'300 rpm', '300 rad/s' or '300 m/s'"),
     ("position: [0.11 m, 0 m]", "position: [25, 43.3]", "bodies[1] 'rod' → position[0]", "'25 mm' or '25 m'"),
     ("stiffness: auto", "stiffness: 1e12", "defaults → contact → stiffness", "'1e+12 N/m^1.5'"),
     ("t_end: 24 ms", "t_end: 0.024", "solver → t_end", "'0.024 ms' or '0.024 s'"),

@@ -20,6 +20,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from clearsim import __version__
+from clearsim.heartbeat import Heartbeat
 from clearsim.process import exit_without_final_collection
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
@@ -89,12 +90,32 @@ ConfigArgument = typer.Argument(None, help="Mechanism YAML file (default: the bu
 SetOption = typer.Option([], "--set", help="Override a value: --set joints.J.clearance=0.1mm (repeatable).")
 
 
+def _line(text: str) -> None:
+    errors.print(text, markup=False, highlight=False, soft_wrap=True)
+
+
+def _warning(text: str) -> None:
+    errors.print(f"[bold yellow]warning:[/] {escape(text)}", markup=True, highlight=False, soft_wrap=True)
+
+
+def heartbeat(command: str) -> Heartbeat | None:
+    """A progress line now and then on stderr when it is not a terminal (there the progress bars show it)."""
+    return None if errors.is_terminal else Heartbeat(_line, f"clearsim {command}")
+
+
 def _progress_bar(t_end: float):
     progress = Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.fields[now]:>9.3f} ms"),
                         TextColumn("of {task.fields[end]:.3f} ms"), TimeElapsedColumn(), console=errors,
                         transient=True, disable=not errors.is_terminal)
     task = progress.add_task("run", total=t_end, now=0.0, end=t_end * 1e3)
-    return progress, lambda t: progress.update(task, completed=t, now=t * 1e3)
+    beat = heartbeat("run")
+
+    def update(t: float) -> None:
+        progress.update(task, completed=t, now=t * 1e3)
+        if beat is not None:
+            beat.beat(f"t = {t * 1e3:.4g} of {t_end * 1e3:.4g} ms simulated", t, t_end)
+
+    return progress, update
 
 
 def _announce_compile() -> None:
@@ -154,8 +175,9 @@ def run(
     _announce_compile()
     system = prepare(loaded)
     progress, update = _progress_bar(system.mechanism.solver.t_end)
+    warned = []  # the run's warnings printed as they came, not again under the summary
     with progress:
-        report = run_to_file(system, loaded, output, update)
+        report = run_to_file(system, loaded, output, update, warn=lambda text: (warned.append(text), _warning(text)))
     if report.backup is not None:
         console.print(f"kept the earlier result as {report.backup}")
     if isinstance(report.error, ResultWriteError):
@@ -164,7 +186,8 @@ def run(
     summary = summarize(report.output)
     console.print(_summary_table(report, summary))
     for warning in summary.warnings:
-        errors.print(f"[bold yellow]warning:[/] {escape(warning)}", markup=True, highlight=False, soft_wrap=True)
+        if warning not in warned:
+            _warning(warning)
     if isinstance(report.error, KeyboardInterrupt):
         raise KeyboardInterrupt
     if report.error is not None:

@@ -121,9 +121,10 @@ def _write_episodes(writer: ResultWriter, system: System, run: Run, sample_episo
 
 
 def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
-                progress: Callable[[float], None] | None = None, contents: str = "all") -> RunReport:
+                progress: Callable[[float], None] | None = None, contents: str = "all",
+                warn: Callable[[str], None] | None = None) -> RunReport:
     """Simulate and write as it goes; interruption or failure still leaves a flagged, readable file with the
-    histories `contents` names (CONTENTS).
+    histories `contents` names (CONTENTS). warn(text): a warning of the run as soon as it is seen (Run.chunks).
 
     Chunks are gathered and written at most every FLUSH_SECONDS of wall time (each HDF5 append
     costs ~0.4 ms per dataset, which for short runs cost more than the integration); whatever was
@@ -141,7 +142,7 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
         pending = _PendingChunks(writer, episodes, system, CONTENTS[contents])
         try:
             run = Run(system)
-            for chunk in run.chunks(progress):
+            for chunk in run.chunks(progress, warn):
                 pending.add(chunk, run)
         except SolverError as exc:
             exc.place = element_place(loaded, exc.element)

@@ -29,13 +29,20 @@ def _rotate(angle, vectors):
     return np.stack([c * vectors[..., 0] - s * vectors[..., 1], s * vectors[..., 0] + c * vectors[..., 1]], axis=-1)
 
 
+def hertz_durations(system: System, joints: np.ndarray, impact_speeds: np.ndarray,
+                    effective_masses: np.ndarray) -> np.ndarray:
+    """t_H = 2.943 δ_max/v (s) of an impact of each clearance joint at δ̇⁻ (at least its min_impact_speed) with its
+    effective mass."""
+    params = system.arrays.clearance_params[joints]
+    speed = np.maximum(impact_speeds, params[:, CL_MIN_IMPACT_SPEED])
+    exponent = params[:, CL_EXPONENT]
+    depth = (5.0 * effective_masses * speed**2 / (4.0 * params[:, CL_STIFFNESS])) ** (1.0 / (exponent + 1.0))
+    return HERTZ_DURATION * depth / speed
+
+
 def classify_episodes(system: System, episodes) -> np.ndarray:
     """IMPACT or CONTINUOUS_CONTACT for each logged contact episode."""
-    params = system.arrays.clearance_params[episodes.joint]
-    speed = np.maximum(episodes.impact_speed, params[:, CL_MIN_IMPACT_SPEED])
-    exponent = params[:, CL_EXPONENT]
-    depth = (5.0 * episodes.effective_mass * speed**2 / (4.0 * params[:, CL_STIFFNESS])) ** (1.0 / (exponent + 1.0))
-    hertz_time = HERTZ_DURATION * depth / speed
+    hertz_time = hertz_durations(system, episodes.joint, episodes.impact_speed, episodes.effective_mass)
     duration = episodes.loss - episodes.onset
     short = np.isfinite(duration) & (duration <= IMPACT_DURATION_FACTOR * hertz_time)
     return np.where(short, IMPACT, CONTINUOUS_CONTACT).astype(np.int8)

@@ -14,14 +14,16 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from clearsim.assembly.arrays import for_kernels
+from clearsim.assembly.arrays import CL_BEARING_RADIUS, CL_MU_D, CL_MU_S, CL_STIFFNESS, for_kernels
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints
 from clearsim.assembly.dynamics import WORK_COUNT
 from clearsim.assembly.forces import FREE
 from clearsim.assembly.system import System
 from clearsim.errors import SolverError
+from clearsim.model.schema import SolverSettings
 from clearsim.solver import integrator as ig
 from clearsim.solver import precompile
+from clearsim.solver.outputs import hertz_durations
 from clearsim.solver.samples import CONTACT_FIELDS, ENERGY_FIELDS, E_KINETIC, E_POTENTIAL, E_VIOLATION
 
 SAMPLE_BUFFER = 2048
@@ -29,6 +31,11 @@ LOG_CAPACITY = 4096
 CHUNKS = 100  # finest progress granularity: the loop returns to Python at least every 1 % of t_end...
 PROGRESS_SECONDS = 0.05  # ...or, when that is quicker, about this often (progress bar, Ctrl-C, the file's flushes)
 GROWTH = 4.0  # a chunk spans at most this many times the simulated time of the one before
+# the pace (docs/model.md §4 "Progress"): judged every WATCH_STEPS tried steps, over those steps
+WATCH_STEPS = 20_000
+COLLAPSED = 1e-3  # a mean step below this fraction of the contact time t_c of a joint in contact: collapsed
+REALISTIC_STIFFNESS = 1e15  # N/m^1.5: above any Hertz contact of steel journals (1e10–1e14 from mm to m radii)
+HOPELESS_STEPS = 1e7  # tried steps still needed to reach t_end at the pace judged: a collapsed run stops, another warns
 
 
 @dataclass
@@ -104,6 +111,89 @@ def chunk_span(finest: float, last_span: float, simulated: float, wall: float) -
     return max(finest, min(GROWTH * last_span, simulated / wall * PROGRESS_SECONDS))
 
 
+@dataclass(frozen=True)
+class Pace:
+    """How far a stretch of the run advanced the time, against the contact time of the joints in contact at its end."""
+
+    time: float  # s, at the stretch's end
+    steps: int  # tried (accepted and rejected)
+    advanced: float  # s of simulated time
+    remaining_time: float  # s to t_end
+    joint: int  # the clearance joint in contact with the shortest contact time, −1 when none is in contact
+    contact_time: float  # s, its Hertz contact time t_c at its impact speed and effective mass; inf when none
+
+    @property
+    def mean_step(self) -> float:
+        return self.advanced / self.steps
+
+    @property
+    def remaining_steps(self) -> float:
+        """Tried steps to reach t_end at this pace."""
+        return self.remaining_time / self.mean_step if self.advanced > 0.0 else np.inf
+
+    @property
+    def collapsed(self) -> bool:
+        """The steps are orders of magnitude below the contact time (an impact is resolved in tens of steps)."""
+        return self.joint >= 0 and self.mean_step < COLLAPSED * self.contact_time
+
+    @property
+    def hopeless(self) -> bool:
+        return self.collapsed and self.remaining_steps > HOPELESS_STEPS
+
+    @property
+    def slow(self) -> bool:
+        return self.remaining_steps > HOPELESS_STEPS
+
+
+def pace_of(system: System, steps: int, advanced: float, time: float, modes: np.ndarray, episode_of: np.ndarray,
+            log: list[np.ndarray]) -> Pace:
+    """The Pace of `steps` tried steps that advanced the time by `advanced`, ending at `time` with these contact
+    modes and episodes (the joints' contact times from their episodes' impact speeds and effective masses)."""
+    in_contact = np.flatnonzero((modes != FREE) & (episode_of >= 0))
+    remaining = float(system.mechanism.solver.t_end) - time
+    if len(in_contact) == 0:
+        return Pace(time, steps, advanced, remaining, -1, np.inf)
+    episodes = episode_of[in_contact]
+    times = hertz_durations(system, in_contact, log[3][episodes], log[4][episodes])
+    shortest = int(np.argmin(times))
+    return Pace(time, steps, advanced, remaining, int(in_contact[shortest]), float(times[shortest]))
+
+
+def mechanism_extent(system: System) -> float:
+    """m: the largest span, along x or y, of the bodies' origins at t = 0 (the mechanism's size)."""
+    positions = system.q0.reshape(-1, 3)[:, :2]
+    return float(np.max(np.ptp(positions, axis=0))) if len(positions) > 1 else 0.0
+
+
+def likely_causes(system: System, pace: Pace) -> list[str]:
+    """What in the model makes the steps this short, as far as its parameters tell."""
+    settings = system.mechanism.solver
+    causes = []
+    if pace.joint >= 0:
+        params = system.arrays.clearance_params[pace.joint]
+        radius, extent = params[CL_BEARING_RADIUS], mechanism_extent(system)
+        if radius > extent > 0.0:
+            causes.append(f"its bearing radius is {radius:.4g} m, more than the whole mechanism measures "
+                          f"({extent:.3g} m): a radius in the wrong unit (m for mm?); its friction acts with that "
+                          "lever arm")
+        if params[CL_STIFFNESS] > REALISTIC_STIFFNESS:
+            causes.append(f"its contact stiffness {params[CL_STIFFNESS]:.3g} N/m^1.5 is above any Hertz contact of "
+                          f"steel ({REALISTIC_STIFFNESS:.0e} N/m^1.5): check `stiffness` and its unit, or use "
+                          "`stiffness: auto`")
+        if max(params[CL_MU_S], params[CL_MU_D]) > 0.0:
+            causes.append("friction that switches or changes far faster than the contact (a large normal force or "
+                          "radius on the friction law's small transition speed): check the friction parameters and "
+                          "their units, or try `friction: {stick: smooth}`")
+    else:
+        causes.append("no clearance joint is in contact, so it is not a contact: a spring, damper, mass or force off "
+                      "by orders of magnitude (a unit), or a drive whose motion jumps")
+    default_min_step = SolverSettings.model_fields["min_step"].default
+    if settings.min_step < default_min_step:
+        causes.append(f"solver.min_step = {settings.min_step:.3g} s lets the steps fall below the default "
+                      f"{default_min_step:g} s, where the run would have stopped")
+    return causes
+
+
 class Run:
     """The integrator's state arrays for one simulation of a System."""
 
@@ -139,6 +229,9 @@ class Run:
         self.kernel_time = 0.0
         self.kernels_compiled = precompile.cache_is_cold()
         self.coordinate_count = n
+        self.watched = (0, 0.0)  # tried steps and time where the stretch being watched began (judge_pace)
+        self.pace_warnings: list[str] = []
+        self.pace_warned: set[str] = set()  # the kinds of pace warned about: "slow", "collapsed"
 
     @property
     def time(self) -> float:
@@ -155,6 +248,9 @@ class Run:
 
     def warnings(self) -> list[str]:
         """What the run did but could not vouch for, in words (empty when nothing)."""
+        return self._coarse_warnings() + self.pace_warnings
+
+    def _coarse_warnings(self) -> list[str]:
         coarse = int(self.ints[ig.I_COARSE])
         if coarse == 0:
             return []
@@ -197,12 +293,15 @@ class Run:
         return Chunk(times, states, modes, speeds, episodes, qdd, lam, contact,
                      energies[:, E_KINETIC], energies[:, E_POTENTIAL], energies[:, E_VIOLATION])
 
-    def chunks(self, progress: Callable[[float], None] | None = None) -> Iterator[Chunk]:
+    def chunks(self, progress: Callable[[float], None] | None = None,
+               warn: Callable[[str], None] | None = None) -> Iterator[Chunk]:
         """Integrate to t_end, yielding samples as they come; SolverError on failure (after the samples).
 
         progress(t) is called at every return of the compiled loop, with or without samples: a run with a tiny
         max_step and a low output rate comes back every STEPS_PER_CALL steps without a sample, and its progress
-        bar must still move. Where the loop stops does not change the result: it pauses between steps."""
+        bar must still move. Where the loop stops does not change the result: it pauses between steps.
+        The pace is judged there too (judge_pace): a collapsed run stops with a SolverError, a slow one calls
+        warn(text) once, as soon as it is seen (the text is also one of `warnings()`)."""
         t_end = self.real[ig.R_T_END]
         span = t_end / CHUNKS
         next_stop = span
@@ -222,11 +321,51 @@ class Run:
                 progress(self.time)
             if status == ig.DONE:
                 return
+            self.judge_pace(warn)
             if status == ig.CHUNK_END:
                 span = chunk_span(t_end / CHUNKS, span, self.time - started_at, self.wall_time - wall_before)
                 next_stop = min(t_end, next_stop + span)
             elif status not in (ig.BUFFER_FULL, ig.PAUSED):
                 raise self._failure(status)
+
+    def judge_pace(self, warn: Callable[[str], None] | None = None) -> Pace | None:
+        """Every WATCH_STEPS tried steps, the Pace of those steps: hopeless → SolverError; collapsed or slow → a
+        warning, once each (kept in `warnings()` and passed to warn). None between judgements."""
+        steps = int(self.ints[ig.I_STEPS] + self.ints[ig.I_REJECTED])
+        started_steps, started_time = self.watched
+        if steps - started_steps < WATCH_STEPS:
+            return None
+        self.watched = (steps, self.time)
+        pace = pace_of(self.system, steps - started_steps, self.time - started_time, self.time, self.modes,
+                       self.episode_of, self.log)
+        if pace.hopeless:
+            raise self._collapse(pace)
+        kind = "collapsed" if pace.collapsed else "slow" if pace.slow else None
+        if kind is not None and kind not in self.pace_warned:  # once each: a slow run may collapse later
+            self.pace_warned.add(kind)
+            self.pace_warnings.append(self._pace_warning(pace))
+            if warn is not None:
+                warn(self.pace_warnings[-1])
+        return pace
+
+    def _pace_text(self, pace: Pace) -> str:
+        """The pace in words: the steps, how far they went, what is left at that pace."""
+        scale = (f", {pace.mean_step / pace.contact_time:.1g} of the contact time t_c = {pace.contact_time:.3g} s of "
+                 f"joint {self.system.clearance_joints[pace.joint]}" if pace.joint >= 0 else "")
+        return (f"the last {pace.steps} steps advanced the time by {pace.advanced:.3g} s, {pace.mean_step:.2g} s a "
+                f"step{scale}; at this pace the remaining {pace.remaining_time * 1e3:.4g} ms take "
+                f"{pace.remaining_steps:.2g} steps")
+
+    def _pace_warning(self, pace: Pace) -> str:
+        text = f"at t = {pace.time * 1e3:.4g} ms {self._pace_text(pace)}"
+        return f"{text}: likely causes: {'; '.join(likely_causes(self.system, pace))}" if pace.collapsed else text
+
+    def _collapse(self, pace: Pace) -> SolverError:
+        """A collapsed run as a failure: the joint, the time, the pace, the likely causes and the fix."""
+        message = f"the steps collapsed far below the contact time, the run cannot reach t_end: {self._pace_text(pace)}"
+        hint = (f"likely causes: {'; '.join(likely_causes(self.system, pace))}. `clearsim validate` and `clearsim draw` "
+                "show the mechanism as read")
+        return SolverError(message, time=pace.time, element=self.system.clearance_joints[pace.joint], hint=hint)
 
     def _failure(self, status: int) -> SolverError:
         """The failure in names: time, the joint involved, what to try."""
@@ -289,10 +428,11 @@ def join_chunks(chunks: list[Chunk]) -> Chunk:
     return Chunk(*(np.concatenate([getattr(c, name) for c in chunks]) for name in Chunk.__dataclass_fields__))
 
 
-def simulate(system: System, progress: Callable[[float], None] | None = None) -> History:
+def simulate(system: System, progress: Callable[[float], None] | None = None,
+             warn: Callable[[str], None] | None = None) -> History:
     """Run to t_end and return the History; SolverError propagates (use Run.chunks to keep partial results)."""
     run = Run(system)
     chunks = []
-    for chunk in run.chunks(progress):
+    for chunk in run.chunks(progress, warn):
         chunks.append(chunk)
     return History(system, join_chunks(chunks), run.episode_log(), run.statistics(), True, "complete")

@@ -1,0 +1,113 @@
+"""A run whose steps collapse far below the contact time stops early, with the joint, the time and the likely cause;
+a healthy run is never judged so (docs/model.md §4 "Progress")."""
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from clearsim.cli import app
+from clearsim.errors import SolverError
+from clearsim.model.loader import load_mechanism
+from clearsim.runner import prepare, simulate_config
+from clearsim.solver import integrator as ig
+from clearsim.solver import simulate as sim
+
+CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
+FRICTION = CONFIGS / "slider_crank_flores_friction.yaml"
+# the radii written in m where mm were meant: a 10 m journal in its bearing, c = 0.5 mm, with friction. Its steps
+# fall to ~2e-12 s at the first contact (t ≈ 0.25 ms), a millionth of the contact time: before the pace was judged
+# such a run ground for minutes (millions of steps, no output) before it stopped at min_step, or never did
+METRES_FOR_MM = ["joints.slider_pin.bearing_radius=10m", "joints.slider_pin.journal_radius=9.9995m"]
+
+
+def tried_steps(statistics) -> int:
+    return statistics.steps + statistics.rejected_steps
+
+
+def test_collapsed_steps_stop_the_run_within_two_judgements(tmp_path):
+    report = simulate_config(FRICTION, METRES_FOR_MM, tmp_path / "r.h5")
+    assert not report.complete
+    assert isinstance(report.error, SolverError), report.status
+    text = str(report.error)
+    assert "slider_pin" in text and "collapsed" in text and "contact time" in text
+    assert "bearing radius is 10 m" in text  # the likely cause, from the joint's parameters
+    assert "slider_crank_flores_friction.yaml:" in text  # located in the file
+    assert report.error.time < 0.3e-3  # where the steps collapsed, not at t_end
+    # fast: within two judgements of the pace (plus one call of the loop), not after millions of steps
+    assert tried_steps(report.statistics) <= 2 * sim.WATCH_STEPS + ig.STEPS_PER_CALL
+    with h5py.File(report.output, "r") as result:  # the partial result is written and flagged
+        assert not result.attrs["complete"] and "collapsed" in result.attrs["status"]
+        assert 0 < len(result["time"]) and result["time"][-1] < 0.3e-3
+
+
+def test_the_cli_stops_a_collapsed_run_with_exit_2_and_no_traceback(tmp_path):
+    result = CliRunner().invoke(app, ["run", str(FRICTION), "-o", str(tmp_path / "r.h5"),
+                                      *[a for s in METRES_FOR_MM for a in ("--set", s)]])
+    assert result.exit_code == 2, result.output
+    assert "error:" in result.output and "collapsed" in result.output and "Traceback" not in result.output
+    assert (tmp_path / "r.h5").exists()
+
+
+def test_a_collapsed_run_that_could_still_finish_warns_as_soon_as_it_is_seen(monkeypatch):
+    """Not hopeless (monkeypatched: any number of steps left is affordable): one warning, at the first judgement
+    that sees the collapse, naming the joint, the time and the likely causes; the run goes on."""
+    monkeypatch.setattr(sim, "HOPELESS_STEPS", np.inf)
+    run = sim.Run(prepare(load_mechanism(FRICTION, METRES_FOR_MM)))
+    warned = []
+
+    class Seen(Exception):
+        pass
+
+    def warn(text):
+        warned.append((text, tried_steps(run.statistics())))
+        raise Seen
+
+    with pytest.raises(Seen):
+        for _ in run.chunks(warn=warn):
+            pass
+    (text, steps), = warned
+    assert steps <= 2 * sim.WATCH_STEPS + ig.STEPS_PER_CALL
+    assert text.startswith("at t = 0.2") and "joint slider_pin" in text and "likely causes" in text
+    assert "bearing radius is 10 m" in text and "friction" in text
+    assert run.warnings() == [text]  # also in the result file's warnings
+
+
+@pytest.mark.parametrize("config, overrides", [
+    (CONFIGS / "uhv_breaker.yaml", []),
+    (CONFIGS / "uhv_breaker.yaml", ["joints.A.clearance=0.1mm", "joints.J.clearance=0.1mm"]),
+    (CONFIGS / "slider_crank_flores.yaml", []),
+    (FRICTION, []),
+    (CONFIGS / "uhv_breaker.yaml", ["solver.rtol=1e-9", "solver.atol=1e-12"]),
+])
+def test_healthy_runs_judged_every_500_steps_never_warn(monkeypatch, config, overrides):
+    """The bundled models, judged 40× more often than by default: over any 500 steps their mean step is at least
+    1.08 % of the contact time (the UHV at rtol 1e-9; 2.4 % at the default tolerances); collapsed is below 0.1 %."""
+    monkeypatch.setattr(sim, "WATCH_STEPS", 500)
+    monkeypatch.setattr(sim, "PROGRESS_SECONDS", 0.0)  # the loop returns every 1 % of t_end: judged that often
+    run = sim.Run(prepare(load_mechanism(config, overrides)))
+    judged = []
+    original = run.judge_pace
+    monkeypatch.setattr(run, "judge_pace", lambda warn=None: judged.append(original(warn)))
+    for _ in run.chunks(warn=pytest.fail):
+        pass
+    paces = [p for p in judged if p is not None]
+    assert len(paces) >= 3  # it was judged
+    assert not any(p.collapsed or p.slow for p in paces) and run.pace_warnings == []
+    in_contact = [p for p in paces if p.joint >= 0]
+    assert in_contact and min(p.mean_step / p.contact_time for p in in_contact) > 5 * sim.COLLAPSED
+
+
+def pace(mean_step, contact_time, joint=0, remaining=0.02):
+    return sim.Pace(0.001, 1000, 1000 * mean_step, remaining, joint, contact_time)
+
+
+def test_pace_verdicts():
+    assert pace(1e-12, 1e-6).collapsed and pace(1e-12, 1e-6).hopeless  # 2e10 steps left
+    assert not pace(1e-12, 1e-6, remaining=1e-6).hopeless  # collapsed, but 1e6 steps finish it: a warning
+    assert not pace(1e-8, 1e-6, remaining=1.0).collapsed and pace(1e-8, 1e-6, remaining=1.0).slow  # 1 % of t_c, 1e8 steps
+    no_contact = pace(1e-15, np.inf, joint=-1)
+    assert not no_contact.collapsed and not no_contact.hopeless and no_contact.slow  # no contact time: never stopped
+    assert pace(0.0, 1e-6).remaining_steps == np.inf

@@ -98,9 +98,9 @@ def _warning(text: str) -> None:
     errors.print(f"[bold yellow]warning:[/] {escape(text)}", markup=True, highlight=False, soft_wrap=True)
 
 
-def heartbeat(command: str) -> Heartbeat | None:
-    """A progress line now and then on stderr when it is not a terminal (there the progress bars show it)."""
-    return None if errors.is_terminal else Heartbeat(_line, f"clearsim {command}")
+def heartbeat(command: str, terminal: Console = errors) -> Heartbeat:
+    """A progress line now and then on stderr, when `terminal` (where the progress bar goes) is not a terminal."""
+    return Heartbeat(_line, f"clearsim {command}", enabled=not terminal.is_terminal)
 
 
 def _progress_bar(t_end: float):
@@ -112,10 +112,9 @@ def _progress_bar(t_end: float):
 
     def update(t: float) -> None:
         progress.update(task, completed=t, now=t * 1e3)
-        if beat is not None:
-            beat.beat(f"t = {t * 1e3:.4g} of {t_end * 1e3:.4g} ms simulated", t, t_end)
+        beat.update(f"t = {t * 1e3:.4g} of {t_end * 1e3:.4g} ms simulated", t, t_end)
 
-    return progress, update
+    return progress, beat, update
 
 
 def _announce_compile() -> None:
@@ -174,9 +173,9 @@ def run(
     _print_plausibility_warnings(loaded)
     _announce_compile()
     system = prepare(loaded)
-    progress, update = _progress_bar(system.mechanism.solver.t_end)
+    progress, beat, update = _progress_bar(system.mechanism.solver.t_end)
     warned = []  # the run's warnings printed as they came, not again under the summary
-    with progress:
+    with progress, beat:
         report = run_to_file(system, loaded, output, update, warn=lambda text: (warned.append(text), _warning(text)))
     if report.backup is not None:
         console.print(f"kept the earlier result as {report.backup}")
@@ -233,9 +232,11 @@ def sweep(
     if scheduler is None:
         _announce_compile()
     progress, update = display.case_progress(errors, len(plan.cases))
+    beat = heartbeat("sweep")
+    count = display.case_heartbeat(beat, len(plan.cases))
     try:
-        with progress:
-            result = run_sweep(plan, executor, update, retry_failed)
+        with progress, beat:
+            result = run_sweep(plan, executor, lambda *finished: (update(*finished), count(*finished)), retry_failed)
     except SweepInterrupted as exc:
         console.print(display.summary_table(exc.result))
         console.print("\n".join(display.closing_lines(exc.result)), soft_wrap=True)

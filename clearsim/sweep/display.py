@@ -25,6 +25,13 @@ def case_progress(console: Console, total: int):
                                                                   last=f"{outcome.name}: {outcome.state}")
 
 
+def case_heartbeat(beat, total: int):
+    """update(outcome, finished, total) for a Heartbeat (clearsim/heartbeat.py): cases finished of all, the last."""
+    beat.update(f"0 of {total} cases finished", 0, total)
+    return lambda outcome, finished, total: beat.update(
+        f"{finished} of {total} cases finished (last: {outcome.name}: {outcome.state})", finished, total)
+
+
 def _number(value, digits: int = 4) -> str:
     if value is None or value == "" or (isinstance(value, float) and math.isnan(value)):
         return "–"

@@ -16,7 +16,7 @@ from typing import List, Optional
 import typer
 from rich.console import Console
 from rich.markup import escape
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from clearsim import __version__
@@ -345,6 +345,23 @@ def synthesize(
                   f"over {record.time[-1] * 1e3:.3f} ms", highlight=False, soft_wrap=True)
 
 
+def _diagnosis_progress():
+    """(live line, heartbeat, update(SearchProgress)): runs done of those planned so far, the best gap and its model,
+    the time elapsed; on stdout with the diagnosis's own lines (in a terminal), else a heartbeat on stderr."""
+    progress = Progress(TextColumn("{task.fields[stage]}"), BarColumn(), MofNCompleteColumn(), TextColumn("runs"),
+                        TextColumn("{task.fields[best]}"), TimeElapsedColumn(), console=console, transient=True,
+                        disable=not console.is_terminal)
+    task = progress.add_task("diagnose", total=None, stage="starting", best="")
+    beat = heartbeat("diagnose", console)
+
+    def update(state) -> None:
+        best = f"best gap {state.best_gap:.3g}: {state.best_label}" if state.best_label else ""
+        progress.update(task, total=state.planned, completed=state.done, stage=state.stage, best=escape(best))
+        beat.update(f"{state.stage}: {state.done} of {state.planned} runs" + (f", {best}" if best else ""))
+
+    return progress, beat, update
+
+
 @app.command()
 @user_errors
 def diagnose(
@@ -368,7 +385,10 @@ def diagnose(
 
     request = DiagnoseRequest(config or BUNDLED_CONFIG, measured, overrides, mapping, candidates, max_effects, out,
                               workers, scheduler, lowpass, fit_top)
-    result = run_diagnosis(request, say=lambda text: console.print(text, highlight=False, soft_wrap=True))
+    progress, beat, update = _diagnosis_progress()
+    with progress, beat:
+        result = run_diagnosis(request, say=lambda text: console.print(text, highlight=False, soft_wrap=True),
+                               progress=update)
     written = write_report(result)
     console.print(f"[bold]{escape(verdict(result))}[/]", soft_wrap=True)
     console.print(f"{result.simulations} simulations in {result.wall_time:.0f} s; report: {written[2]}",

@@ -131,11 +131,64 @@ class Scored:
     allowance: float = 1.0  # Δχ² of the profile interval, set by `judge`
 
 
-def evaluate_points(evaluator: Evaluator, record: Record, sensors: list[str],
+@dataclass
+class SearchProgress:
+    """What a diagnosis has run so far (its progress bar and heartbeat)."""
+
+    stage: str = "starting"
+    planned: int = 0  # model runs asked for so far: each batch adds its own when it is asked for
+    done: int = 0  # of those, finished (run, reused or failed)
+    best_gap: float = np.inf  # the lowest gap of a finished run so far
+    best_label: str = ""  # its model: "the model as given", or the candidate's setting(s)
+
+
+class Tracked:
+    """An Evaluator that counts the runs asked for and finished and keeps the best fit so far, and calls
+    report(progress) at each change. `evaluate` takes a label per document (the variant in words, `setting`)."""
+
+    def __init__(self, evaluator: Evaluator, report: Callable[[SearchProgress], None] = lambda progress: None):
+        self.evaluator, self.report = evaluator, report
+        self.progress = SearchProgress()
+
+    @property
+    def simulations(self) -> int:
+        return self.evaluator.simulations
+
+    def stage(self, text: str) -> None:
+        self.progress.stage = text
+        self.report(self.progress)
+
+    def evaluate(self, documents: list[dict], then: Callable, labels: list[str]) -> list:
+        progress = self.progress
+        progress.planned += len(documents)
+        self.report(progress)
+
+        def counted(i: int, prediction: Prediction):
+            result = then(i, prediction)
+            progress.done += 1
+            fit = getattr(result, "fit", None)
+            if fit is not None and fit.gap < progress.best_gap:
+                progress.best_gap, progress.best_label = fit.gap, labels[i]
+            self.report(progress)
+            return result
+
+        return self.evaluator.evaluate(documents, counted)
+
+
+AS_GIVEN = "the model as given"
+
+
+def setting(candidates: list[Candidate], values) -> str:
+    """'clearance in joint B, clearance = 0.082 mm' (several effects: joined by '; ')."""
+    return "; ".join(f"{c.label}, {c.parameter} = {c.shown(v)}" for c, v in zip(candidates, values))
+
+
+def evaluate_points(evaluator: Tracked, record: Record, sensors: list[str],
                     jobs: list[tuple[Scored, float]], document: dict) -> None:
     """Run candidate values (all at once, in parallel) and append the fitted points (each scored as its run ends)."""
     points = evaluator.evaluate([scored.candidate.applied(document, value) for scored, value in jobs],
-                                lambda i, prediction: score_point(record, sensors, jobs[i][1], prediction))
+                                lambda i, prediction: score_point(record, sensors, jobs[i][1], prediction),
+                                [setting([scored.candidate], [value]) for scored, value in jobs])
     for (scored, _), point in zip(jobs, points):
         scored.points.append(point)
 
@@ -168,7 +221,8 @@ def screen(evaluator, record, sensors, candidates: list[Candidate], document,
             check_model(prediction)
         return score_point(record, sensors, jobs[i - 1][1] if i else 0.0, prediction)
 
-    points = evaluator.evaluate([document] + [s.candidate.applied(document, v) for s, v in jobs], point)
+    points = evaluator.evaluate([document] + [s.candidate.applied(document, v) for s, v in jobs], point,
+                                [AS_GIVEN] + [setting([s.candidate], [v]) for s, v in jobs])
     for (s, _), screened in zip(jobs, points[1:]):
         s.points.append(screened)
     baseline = points[0]
@@ -477,7 +531,7 @@ class JointFit:
         return list(zip(self.values(low), self.values(high)))
 
 
-def refit_jointly(evaluator: Evaluator, record: Record, sensors: list[str], document: dict,
+def refit_jointly(evaluator: Tracked, record: Record, sensors: list[str], document: dict,
                   candidates: list[Candidate], start, rounds: int = REFIT_ROUNDS) -> JointFit:
     """Refit the effects' values together, starting from the greedy ones: each round runs a stencil of
     axial and pairwise-diagonal neighbours of the best point (one parallel batch), then the minimum of a
@@ -500,7 +554,8 @@ def _run_joint(evaluator, record, sensors, document, joint: JointFit, units: lis
     known = {p.value for p in joint.points}
     new = [v for v in dict.fromkeys(joint.values(u) for u in units) if v not in known]
     joint.points += evaluator.evaluate([with_effects(document, joint.candidates, v) for v in new],
-                                       lambda i, prediction: score_point(record, sensors, new[i], prediction))
+                                       lambda i, prediction: score_point(record, sensors, new[i], prediction),
+                                       [setting(joint.candidates, v) for v in new])
 
 
 def stencil(centre: np.ndarray, step: float) -> list[np.ndarray]:

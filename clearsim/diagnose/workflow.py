@@ -24,8 +24,9 @@ from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for, with_
 from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
 from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
-from clearsim.diagnose.search import (SIGNIFICANCE, JointFit, Point, Scored, halves_improved, judge, low_band_best,
-                                     mark_ties, refine, refit_jointly, score_point, screen, seen_by_sensors, to_fit)
+from clearsim.diagnose.search import (SIGNIFICANCE, JointFit, Point, Scored, SearchProgress, Tracked, halves_improved,
+                                     judge, low_band_best, mark_ties, refine, refit_jointly, score_point, screen,
+                                     seen_by_sensors, setting, to_fit)
 from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.model.loader import load_mechanism, load_mechanism_text
 from clearsim.units import UnitError, to_si
@@ -191,8 +192,11 @@ def default_folder(request: DiagnoseRequest) -> Path:
     return RESULTS / f"diagnose-{Path(request.config).stem}-{Path(request.measured).stem}"
 
 
-def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text: None) -> Diagnosis:
-    """The whole workflow; every input problem is a ClearsimError raised before any run."""
+def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text: None,
+             progress: Callable[[SearchProgress], None] = lambda progress: None) -> Diagnosis:
+    """The whole workflow; every input problem is a ClearsimError raised before any run. progress(state) is called
+    whenever runs are asked for or one finishes, and at each stage (SearchProgress: runs done of those planned so far,
+    the best gap and its model)."""
     started = clock.perf_counter()
     if request.max_effects < 1:
         raise DiagnoseError(f"--max-effects must be at least 1, got {request.max_effects}")
@@ -223,7 +227,8 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
     original = document
     folder = Path(request.out) if request.out else default_folder(request)
     executor = _executor(request)
-    evaluator = Evaluator(folder / "runs", str(request.config), Path(request.config).parent, executor, record.rate)
+    evaluator = Tracked(Evaluator(folder / "runs", str(request.config), Path(request.config).parent, executor,
+                                  record.rate), progress)
     iterations: list[Iteration] = []
     joint = None
     try:
@@ -237,6 +242,7 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
             document = iteration.found.candidate.applied(document, iteration.found.estimate.value)
         effects = [found_effect(it.found, it.baseline) for it in iterations if it.found is not None]
         if len(effects) >= 2:
+            evaluator.stage(f"refitting {len(effects)} effects together")
             joint = refit_jointly(evaluator, record, sensors, original, [e.candidate for e in effects],
                                   [e.value for e in effects])
             effects = refitted(evaluator, record, sensors, original, effects, joint)
@@ -255,7 +261,8 @@ def refitted(evaluator, record: Record, sensors: list[str], document: dict, effe
     values = joint.best.value
     candidates = [e.candidate for e in effects]
     nested = evaluator.evaluate([with_effects(document, candidates[:k], values[:k]) for k in range(1, len(effects))],
-                                lambda i, prediction: score_point(record, sensors, values[:i + 1], prediction))
+                                lambda i, prediction: score_point(record, sensors, values[:i + 1], prediction),
+                                [setting(candidates[:k], values[:k]) for k in range(1, len(effects))])
     points = nested + [joint.best]
     failed = next((p for p in points if p.fit is None), None)
     if failed is not None:
@@ -291,6 +298,7 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
                                 "fix it with `clearsim run` first")
 
     candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds, Path(request.config).parent) if c.key not in found_keys]
+    evaluator.stage(f"iteration {number}: screening {candidates_count(len(candidates))}")
     base_point, scored = screen(evaluator, record, sensors, candidates, document, check_model)
     base_prediction = base_point.prediction
     baseline = base_point.fit
@@ -303,6 +311,7 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     chosen = to_fit(visible, base_point, record, request.fit_top)
     say(f"  screened {len(candidates)} candidates ({len(visible)} visible to the sensors); fitting "
         + ", ".join(s.candidate.label for s in chosen))
+    evaluator.stage(f"iteration {number}: fitting {candidates_count(len(chosen))}")
     refine(evaluator, record, sensors, chosen, document)
     ranked = judge(scored, baseline, record)
     winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
@@ -318,6 +327,10 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
+
+
+def candidates_count(count: int) -> str:
+    return f"{count} candidate{'' if count == 1 else 's'}"
 
 
 def seen_below_chaos(scored: Scored, baseline: Point, record: Record) -> bool:

@@ -124,7 +124,7 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                 progress: Callable[[float], None] | None = None, contents: str = "all",
                 warn: Callable[[str], None] | None = None) -> RunReport:
     """Simulate and write as it goes; interruption or failure still leaves a flagged, readable file with the
-    histories `contents` names (CONTENTS). warn(text): a warning of the run as soon as it is seen (Run.chunks).
+    histories `contents` names (CONTENTS). warn(text): a warning of the run as soon as it is seen (Run).
 
     Chunks are gathered and written at most every FLUSH_SECONDS of wall time (each HDF5 append
     costs ~0.4 ms per dataset, which for short runs cost more than the integration); whatever was
@@ -141,8 +141,8 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     with np.errstate(all="ignore"), ResultWriter(output, loaded.resolved_yaml, attributes) as writer:
         pending = _PendingChunks(writer, episodes, system, CONTENTS[contents])
         try:
-            run = Run(system)
-            for chunk in run.chunks(progress, warn):
+            run = Run(system, warn)
+            for chunk in run.chunks(progress):
                 pending.add(chunk, run)
         except SolverError as exc:
             exc.place = element_place(loaded, exc.element)

@@ -195,10 +195,12 @@ def likely_causes(system: System, pace: Pace) -> list[str]:
 
 
 class Run:
-    """The integrator's state arrays for one simulation of a System."""
+    """The integrator's state arrays for one simulation of a System; warn(text) is told a warning of the run as soon
+    as it is seen (judge_pace)."""
 
-    def __init__(self, system: System):
+    def __init__(self, system: System, warn: Callable[[str], None] | None = None):
         self.system = system
+        self.warn = warn
         settings = system.mechanism.solver
         arrays = system.arrays
         self.kernel_arrays = for_kernels(arrays)
@@ -293,15 +295,13 @@ class Run:
         return Chunk(times, states, modes, speeds, episodes, qdd, lam, contact,
                      energies[:, E_KINETIC], energies[:, E_POTENTIAL], energies[:, E_VIOLATION])
 
-    def chunks(self, progress: Callable[[float], None] | None = None,
-               warn: Callable[[str], None] | None = None) -> Iterator[Chunk]:
+    def chunks(self, progress: Callable[[float], None] | None = None) -> Iterator[Chunk]:
         """Integrate to t_end, yielding samples as they come; SolverError on failure (after the samples).
 
         progress(t) is called at every return of the compiled loop, with or without samples: a run with a tiny
         max_step and a low output rate comes back every STEPS_PER_CALL steps without a sample, and its progress
         bar must still move. Where the loop stops does not change the result: it pauses between steps.
-        The pace is judged there too (judge_pace): a collapsed run stops with a SolverError, a slow one calls
-        warn(text) once, as soon as it is seen (the text is also one of `warnings()`)."""
+        The pace is judged there too (judge_pace): a collapsed run stops with a SolverError, a slow one warns."""
         t_end = self.real[ig.R_T_END]
         span = t_end / CHUNKS
         next_stop = span
@@ -321,16 +321,16 @@ class Run:
                 progress(self.time)
             if status == ig.DONE:
                 return
-            self.judge_pace(warn)
+            self.judge_pace()
             if status == ig.CHUNK_END:
                 span = chunk_span(t_end / CHUNKS, span, self.time - started_at, self.wall_time - wall_before)
                 next_stop = min(t_end, next_stop + span)
             elif status not in (ig.BUFFER_FULL, ig.PAUSED):
                 raise self._failure(status)
 
-    def judge_pace(self, warn: Callable[[str], None] | None = None) -> Pace | None:
+    def judge_pace(self) -> Pace | None:
         """Every WATCH_STEPS tried steps, the Pace of those steps: hopeless → SolverError; collapsed or slow → a
-        warning, once each (kept in `warnings()` and passed to warn). None between judgements."""
+        warning, once each (kept in `warnings()` and told to `warn`). None between judgements."""
         steps = int(self.ints[ig.I_STEPS] + self.ints[ig.I_REJECTED])
         started_steps, started_time = self.watched
         if steps - started_steps < WATCH_STEPS:
@@ -344,8 +344,8 @@ class Run:
         if kind is not None and kind not in self.pace_warned:  # once each: a slow run may collapse later
             self.pace_warned.add(kind)
             self.pace_warnings.append(self._pace_warning(pace))
-            if warn is not None:
-                warn(self.pace_warnings[-1])
+            if self.warn is not None:
+                self.warn(self.pace_warnings[-1])
         return pace
 
     def _pace_text(self, pace: Pace) -> str:
@@ -431,8 +431,8 @@ def join_chunks(chunks: list[Chunk]) -> Chunk:
 def simulate(system: System, progress: Callable[[float], None] | None = None,
              warn: Callable[[str], None] | None = None) -> History:
     """Run to t_end and return the History; SolverError propagates (use Run.chunks to keep partial results)."""
-    run = Run(system)
+    run = Run(system, warn)
     chunks = []
-    for chunk in run.chunks(progress, warn):
+    for chunk in run.chunks(progress):
         chunks.append(chunk)
     return History(system, join_chunks(chunks), run.episode_log(), run.statistics(), True, "complete")

@@ -55,7 +55,6 @@ def test_a_collapsed_run_that_could_still_finish_warns_as_soon_as_it_is_seen(mon
     """Not hopeless (monkeypatched: any number of steps left is affordable): one warning, at the first judgement
     that sees the collapse, naming the joint, the time and the likely causes; the run goes on."""
     monkeypatch.setattr(sim, "HOPELESS_STEPS", np.inf)
-    run = sim.Run(prepare(load_mechanism(FRICTION, METRES_FOR_MM)))
     warned = []
 
     class Seen(Exception):
@@ -65,8 +64,9 @@ def test_a_collapsed_run_that_could_still_finish_warns_as_soon_as_it_is_seen(mon
         warned.append((text, tried_steps(run.statistics())))
         raise Seen
 
+    run = sim.Run(prepare(load_mechanism(FRICTION, METRES_FOR_MM)), warn)
     with pytest.raises(Seen):
-        for _ in run.chunks(warn=warn):
+        for _ in run.chunks():
             pass
     (text, steps), = warned
     assert steps <= 2 * sim.WATCH_STEPS + ig.STEPS_PER_CALL
@@ -87,11 +87,11 @@ def test_healthy_runs_judged_every_500_steps_never_warn(monkeypatch, config, ove
     1.08 % of the contact time (the UHV at rtol 1e-9; 2.4 % at the default tolerances); collapsed is below 0.1 %."""
     monkeypatch.setattr(sim, "WATCH_STEPS", 500)
     monkeypatch.setattr(sim, "PROGRESS_SECONDS", 0.0)  # the loop returns every 1 % of t_end: judged that often
-    run = sim.Run(prepare(load_mechanism(config, overrides)))
+    run = sim.Run(prepare(load_mechanism(config, overrides)), warn=pytest.fail)
     judged = []
     original = run.judge_pace
-    monkeypatch.setattr(run, "judge_pace", lambda warn=None: judged.append(original(warn)))
-    for _ in run.chunks(warn=pytest.fail):
+    monkeypatch.setattr(run, "judge_pace", lambda: judged.append(original()))
+    for _ in run.chunks():
         pass
     paces = [p for p in judged if p is not None]
     assert len(paces) >= 3  # it was judged

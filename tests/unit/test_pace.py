@@ -111,3 +111,29 @@ def test_pace_verdicts():
     no_contact = pace(1e-15, np.inf, joint=-1)
     assert not no_contact.collapsed and not no_contact.hopeless and no_contact.slow  # no contact time: never stopped
     assert pace(0.0, 1e-6).remaining_steps == np.inf
+
+
+def test_likely_causes_are_read_from_the_joints_parameters():
+    """A stiffness above any steel contact and a min_step below its default are named; the bundled model has none of
+    the causes a parameter can show (its friction-free joint, its 10 mm bearing, its stiffness from `auto`)."""
+    stiff = prepare(load_mechanism(CONFIGS / "slider_crank_flores.yaml",
+                                   ["defaults.contact.stiffness=1e20N/m^1.5", "solver.min_step=1e-16s"]))
+    causes = sim.likely_causes(stiff, pace(1e-15, 1e-9))
+    assert any("contact stiffness 1e+20 N/m^1.5" in c for c in causes)
+    assert any("solver.min_step = 1e-16 s" in c for c in causes)
+    assert sim.likely_causes(prepare(load_mechanism(CONFIGS / "slider_crank_flores.yaml")), pace(1e-15, 1e-9)) == []
+    free = sim.likely_causes(stiff, pace(1e-15, np.inf, joint=-1))
+    assert "no clearance joint is in contact" in free[0]
+
+
+def test_a_slow_run_warns_once_with_its_pace_and_finishes(monkeypatch):
+    """With 10 steps called too many to wait for, the healthy slider-crank (2126 steps) is slow at every judgement:
+    one warning with the pace, told at once, and the run completes (slow is not collapsed)."""
+    monkeypatch.setattr(sim, "WATCH_STEPS", 500)
+    monkeypatch.setattr(sim, "PROGRESS_SECONDS", 0.0)
+    monkeypatch.setattr(sim, "HOPELESS_STEPS", 10)
+    warned = []
+    history = sim.simulate(prepare(load_mechanism(CONFIGS / "slider_crank_flores.yaml")), warn=warned.append)
+    assert history.complete and history.chunk.times[-1] == pytest.approx(0.024)
+    (text,) = warned
+    assert text.startswith("at t = ") and "at this pace the remaining" in text and "likely causes" not in text

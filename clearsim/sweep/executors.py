@@ -10,15 +10,19 @@ from __future__ import annotations
 import multiprocessing
 import os
 import signal
+import tempfile
 import uuid
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Callable, Sequence
 
+from clearsim.errors import ClearsimError
+from clearsim.io.hdf5 import keep_as_previous
 from clearsim.solver import precompile
 from clearsim.sweep.grid import SweepOptionError
-from clearsim.sweep.worker import FAILED, INTERRUPTED, CaseOutcome, CaseTask, init_pool_worker
+from clearsim.sweep.worker import FAILED, INTERRUPTED, CaseOutcome, CaseTask, init_pool_worker, reused_outcome
 
 Collect = Callable[[CaseOutcome], None]
 MAX_WORKERS_PER_CORE = 4  # a case is compiled code using one core: more processes only add memory
@@ -276,8 +280,8 @@ def check_address(address: str) -> str:
 
 
 class DaskCluster:
-    """An existing dask.distributed cluster at `address` (tcp://host:8786); its workers need clearsim
-    installed and the sweep folder on a shared file system at the same path."""
+    """An existing dask.distributed cluster at `address` (tcp://host:8786); its workers need clearsim installed
+    (and the CSV tables the mechanism reads, at the same path); the result files come back to this machine."""
 
     def __init__(self, address: str, workers: int | None = None):
         if workers is not None:
@@ -312,7 +316,10 @@ class DaskCluster:
                                    "  hint: start one with `dask scheduler` and workers with `dask worker ADDRESS`") from None
 
     def run(self, function: Callable, tasks: Sequence[CaseTask], collect: Collect) -> bool:
-        """As LocalPool.run; on Ctrl-C the cases not started are cancelled, running ones finish on the cluster."""
+        """As LocalPool.run, without a shared file system: whether a case's file is there to reuse is decided
+        here, each case runs in a scratch folder of its worker, and its file comes back with its outcome and is
+        written into the sweep folder here. On Ctrl-C the cases not started are cancelled; the results of
+        running ones are not waited for (those cases run again on resume)."""
         from distributed import as_completed
 
         self.connect()
@@ -320,12 +327,57 @@ class DaskCluster:
         futures, token = {}, uuid.uuid4().hex[:8]
         try:
             for task in tasks:
-                futures[client.submit(function, task, key=f"clearsim-{token}-{task.name}", pure=False)] = task
+                if (reused := _reused_here(task)) is not None:
+                    collect(reused)
+                    continue
+                shipped = replace(task, output=Path(task.output).name)  # the worker's scratch folder holds it
+                futures[client.submit(run_shipped, function, shipped, key=f"clearsim-{token}-{task.name}",
+                                      pure=False)] = task
             for future in as_completed(list(futures)):
-                collect(_result(future, futures[future]))
+                task = futures.pop(future)
+                collect(_received(task, future))
         except KeyboardInterrupt:
             return True
         finally:
             client.cancel(list(futures))
             client.close()
         return False
+
+
+def _reused_here(task: CaseTask) -> CaseOutcome | None:
+    """The case's outcome when the sweep folder holds its result already (the folder made ready otherwise)."""
+    try:
+        return reused_outcome(task)
+    except ClearsimError as exc:
+        return CaseOutcome(task.name, FAILED, True, str(exc))
+
+
+def run_shipped(function: Callable, task: CaseTask) -> tuple[CaseOutcome, bytes | None]:
+    """On a worker: the case with its file in a scratch folder of this machine; its outcome and the file's bytes
+    (None when it wrote none) go back to the machine that holds the sweep folder."""
+    with tempfile.TemporaryDirectory(prefix="clearsim-case-") as scratch:
+        output = Path(scratch) / task.output
+        outcome = function(replace(task, output=str(output)))
+        return outcome, output.read_bytes() if output.exists() else None
+
+
+def _received(task: CaseTask, future) -> CaseOutcome:
+    """A case's outcome from the cluster, its file written into the sweep folder (a file already there is kept as
+    .previous, never overwritten); a file that cannot be written fails the case with the reason."""
+    try:
+        outcome, data = future.result()
+    except Exception as exc:
+        return _lost(task, exc)
+    if data is None:
+        return outcome
+    output = Path(task.output)
+    partial = output.with_name(output.name + ".part")
+    try:
+        partial.write_bytes(data)
+        keep_as_previous(output)
+        partial.replace(output)
+    except OSError as exc:
+        partial.unlink(missing_ok=True)
+        return CaseOutcome(task.name, FAILED, True, f"its result file ({len(data) / 1e6:.1f} MB) came back from "
+                                                    f"the cluster but cannot be written to {output}: {exc}")
+    return outcome

@@ -216,9 +216,10 @@ class _Batch:
         reason; the others run again on a new pool. A process ended by SIGTERM looks like the ones the pool ends
         itself: then no case is blamed and every one runs again (MAX_POOL_REBUILDS bounds the repeats)."""
         processes = dict(self.pool.executor._processes or {})
-        running = _running(self.pool.board)
         self.pool.executor.shutdown(wait=True)  # the pool has ended its processes: their exit codes are known
-        deaths = _deaths(processes, running)
+        # read once they have ended: a process that the pool's SIGTERM reached while writing its file ends its
+        # case in order (clearing its slot) and exits with code 0
+        deaths = _deaths(processes, _running(self.pool.board))
         self.rebuilds += 1
         again = []
         for future, index in sorted(self.futures.items(), key=lambda item: item[1]):

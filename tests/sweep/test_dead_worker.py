@@ -13,7 +13,7 @@ import h5py
 import pytest
 
 from clearsim.sweep import LocalPool, SweepRequest, executors, plan_sweep, run_sweep
-from clearsim.sweep.worker import COMPLETE, FAILED
+from clearsim.sweep.worker import COMPLETE, FAILED, INTERRUPTED, CaseOutcome, CaseTask
 
 SLIDER_CRANK = Path(__file__).resolve().parents[2] / "clearsim" / "configs" / "slider_crank_flores.yaml"
 SHORT = "solver.t_end=4ms"
@@ -75,6 +75,41 @@ def test_a_pool_whose_workers_keep_dying_is_started_again_a_bounded_number_of_ti
     assert [o.state for o in result.outcomes.values()] == [FAILED] * 5
     assert errors[:2] == ["worker killed by signal 9 (SIGKILL) while running this case"] * 2
     assert errors[2:] == ["not run: worker processes died 2 times in this sweep, the pool was not started again"] * 3
+
+
+def _b_ends_in_order_a_is_killed(folder: str, task: CaseTask) -> CaseOutcome:
+    """Case b ends in order on SIGTERM, as a case writing its file does (it defers the signal and then returns as
+    interrupted, and its process exits with code 0); case a kills its own process while b runs. Both complete
+    when run again (a-killed exists)."""
+    killed, running = Path(folder) / "a-killed", Path(folder) / "b-running"
+    if killed.exists():
+        return CaseOutcome(task.name, COMPLETE, True)
+    if task.name == "a":
+        while not running.exists():
+            time.sleep(0.01)
+        killed.touch()
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    def ended_in_order(signum, frame):
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, ended_in_order)
+    running.touch()
+    try:
+        time.sleep(60)
+    except KeyboardInterrupt:
+        return CaseOutcome(task.name, INTERRUPTED, True, "interrupted")
+    return CaseOutcome(task.name, FAILED, True, "never ended by the pool")
+
+
+def test_a_case_the_pool_ended_in_order_after_the_death_is_not_blamed_for_it(tmp_path):
+    collected = {}
+    tasks = [CaseTask(name, "", "", "", (), "") for name in ("b", "a")]
+    assert not LocalPool(2).run(functools.partial(_b_ends_in_order_a_is_killed, str(tmp_path)), tasks,
+                                lambda outcome: collected.setdefault(outcome.name, outcome))
+    assert (collected["a"].state, collected["a"].error) == (FAILED, "worker killed by signal 9 (SIGKILL) while "
+                                                                     "running this case")
+    assert collected["b"].state == COMPLETE, collected["b"].error
 
 
 @pytest.mark.parametrize("exitcode, reason", [(-9, "worker killed by signal 9 (SIGKILL)"),

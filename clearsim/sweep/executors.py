@@ -22,7 +22,8 @@ from clearsim.errors import ClearsimError
 from clearsim.io.hdf5 import keep_as_previous
 from clearsim.solver import precompile
 from clearsim.sweep.grid import SweepOptionError
-from clearsim.sweep.worker import FAILED, INTERRUPTED, CaseOutcome, CaseTask, init_pool_worker, reused_outcome
+from clearsim.sweep.worker import (FAILED, INTERRUPTED, CaseOutcome, CaseTask, init_pool_worker, load_case,
+                                   reused_outcome)
 
 Collect = Callable[[CaseOutcome], None]
 MAX_WORKERS_PER_CORE = 4  # a case is compiled code using one core: more processes only add memory
@@ -325,15 +326,15 @@ class DaskCluster:
 
         self.connect()
         client, self.client = self.client, None
-        futures, token = {}, uuid.uuid4().hex[:8]
+        futures, token, read = {}, uuid.uuid4().hex[:8], {}
         try:
             for task in tasks:
                 if (reused := _reused_here(task)) is not None:
                     collect(reused)
                     continue
                 shipped = replace(task, output=Path(task.output).name)  # the worker's scratch folder holds it
-                futures[client.submit(run_shipped, function, shipped, key=f"clearsim-{token}-{task.name}",
-                                      pure=False)] = task
+                futures[client.submit(run_shipped, function, shipped, _tables(task, read),
+                                      key=f"clearsim-{token}-{task.name}", pure=False)] = task
             for future in as_completed(list(futures)):
                 task = futures.pop(future)
                 collect(_received(task, future))
@@ -353,12 +354,37 @@ def _reused_here(task: CaseTask) -> CaseOutcome | None:
         return CaseOutcome(task.name, FAILED, True, str(exc))
 
 
-def run_shipped(function: Callable, task: CaseTask) -> tuple[CaseOutcome, bytes | None]:
-    """On a worker: the case with its file in a scratch folder of this machine; its outcome and the file's bytes
-    (None when it wrote none) go back to the machine that holds the sweep folder."""
+def _tables(task: CaseTask, read: dict[Path, bytes]) -> dict[str, bytes]:
+    """The CSV tables the case reads (every `file:` of its mechanism, relative to the YAML file) that are here,
+    to go with it to a worker that does not see them; `read` keeps the bytes of those read already."""
+    base = Path(task.base_dir)
+    names = {name for name in _file_keys(load_case(task).mechanism.model_dump()) if not Path(name).is_absolute()}
+    for path in {base / name for name in names} - set(read):
+        read[path] = path.read_bytes() if path.is_file() else None
+    return {name: read[base / name] for name in sorted(names) if read[base / name] is not None}
+
+
+def _file_keys(value) -> list[str]:
+    if isinstance(value, dict):
+        return [item for key, inner in value.items()
+                for item in ([inner] if key == "file" and isinstance(inner, str) else _file_keys(inner))]
+    if isinstance(value, list):
+        return [item for inner in value for item in _file_keys(inner)]
+    return []
+
+
+def run_shipped(function: Callable, task: CaseTask, tables: dict[str, bytes]) -> tuple[CaseOutcome, bytes | None]:
+    """On a worker: the case with its file in a scratch folder of this machine, and its CSV tables there beside a
+    stand-in for the YAML file's folder; its outcome and the file's bytes (None when it wrote none) go back to the
+    machine that holds the sweep folder."""
     with tempfile.TemporaryDirectory(prefix="clearsim-case-") as scratch:
-        output = Path(scratch) / task.output
-        outcome = function(replace(task, output=str(output)))
+        output, base = Path(scratch) / task.output, Path(scratch) / "config"
+        for name, data in tables.items():
+            table = (base / name).resolve()
+            if table.is_relative_to(Path(scratch).resolve()):  # a name climbing out of it is not written
+                table.parent.mkdir(parents=True, exist_ok=True)
+                table.write_bytes(data)
+        outcome = function(replace(task, output=str(output), base_dir=str(base) if tables else task.base_dir))
         return outcome, output.read_bytes() if output.exists() else None
 
 

@@ -95,3 +95,17 @@ def test_a_rerun_on_the_cluster_reuses_the_files_of_the_clients_folder_and_keeps
     again = run_sweep(plan_sweep(changed, SLIDER_CRANK), DaskCluster(address))
     assert sorted(again.ran) == ["clearance-0.25_mm", "ideal"]
     assert sorted(p.name for p in out.glob("*.previous.h5")) == ["clearance-0.25_mm.previous.h5", "ideal.previous.h5"]
+
+
+def test_the_csv_tables_of_the_mechanism_go_with_each_case_to_workers_that_do_not_see_them(separate_cluster):
+    address, client_root, _ = separate_cluster
+    config = client_root / "kicked" / "slider_crank.yaml"
+    (config.parent / "tables").mkdir(parents=True)
+    config.write_text(SLIDER_CRANK.read_text() + "forces:\n  - {type: tabulated, name: kick, body: slider, "
+                      "direction: [1, 0], file: tables/kick.csv}\n")
+    (config.parent / "tables" / "kick.csv").write_text("0,0\n0.001,50\n0.002,0\n")
+    result = run_sweep(plan_sweep(SweepRequest(config, [SHORT], "0.25", out=client_root / "kicked-sweep"), config),
+                       DaskCluster(address))
+    assert {name: outcome.error for name, outcome in result.outcomes.items()} == {"ideal": "",
+                                                                                   "clearance-0.25_mm": ""}
+    assert result.count("complete") == 2

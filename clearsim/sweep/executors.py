@@ -355,13 +355,15 @@ def _reused_here(task: CaseTask) -> CaseOutcome | None:
 
 
 def _tables(task: CaseTask, read: dict[Path, bytes]) -> dict[str, bytes]:
-    """The CSV tables the case reads (every `file:` of its mechanism, relative to the YAML file) that are here,
-    to go with it to a worker that does not see them; `read` keeps the bytes of those read already."""
+    """The CSV tables the case reads (every `file:` of its mechanism, relative to the YAML file), to go with it to
+    a worker that does not see them; none when one is missing here (the worker then reports it at its path here).
+    `read` keeps the bytes of those read already."""
     base = Path(task.base_dir)
     names = {name for name in _file_keys(load_case(task).mechanism.model_dump()) if not Path(name).is_absolute()}
     for path in {base / name for name in names} - set(read):
         read[path] = path.read_bytes() if path.is_file() else None
-    return {name: read[base / name] for name in sorted(names) if read[base / name] is not None}
+    tables = {name: read[base / name] for name in sorted(names)}
+    return tables if None not in tables.values() else {}
 
 
 def _file_keys(value) -> list[str]:
@@ -375,16 +377,17 @@ def _file_keys(value) -> list[str]:
 
 def run_shipped(function: Callable, task: CaseTask, tables: dict[str, bytes]) -> tuple[CaseOutcome, bytes | None]:
     """On a worker: the case with its file in a scratch folder of this machine, and its CSV tables there beside a
-    stand-in for the YAML file's folder; its outcome and the file's bytes (None when it wrote none) go back to the
-    machine that holds the sweep folder."""
+    stand-in for the YAML file's folder (all of them, or none when a name climbs out of the scratch folder: then
+    they are read at the YAML file's folder); its outcome and the file's bytes (None when it wrote none) go back
+    to the machine that holds the sweep folder."""
     with tempfile.TemporaryDirectory(prefix="clearsim-case-") as scratch:
         output, base = Path(scratch) / task.output, Path(scratch) / "config"
-        for name, data in tables.items():
-            table = (base / name).resolve()
-            if table.is_relative_to(Path(scratch).resolve()):  # a name climbing out of it is not written
-                table.parent.mkdir(parents=True, exist_ok=True)
-                table.write_bytes(data)
-        outcome = function(replace(task, output=str(output), base_dir=str(base) if tables else task.base_dir))
+        placed = {(base / name).resolve(): data for name, data in tables.items()}
+        sent = bool(placed) and all(path.is_relative_to(Path(scratch).resolve()) for path in placed)
+        for path, data in placed.items() if sent else ():
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data)
+        outcome = function(replace(task, output=str(output), base_dir=str(base) if sent else task.base_dir))
         return outcome, output.read_bytes() if output.exists() else None
 
 

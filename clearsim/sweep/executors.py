@@ -3,6 +3,8 @@
 Both hand each outcome to a callback as its case finishes. Ctrl-C cancels the cases not yet
 started; cases already running in the pool are interrupted (their files flagged incomplete) and
 their outcomes still collected, so the summary matches the files. A second Ctrl-C leaves at once.
+A process of the local pool that dies fails only the case it was running (the pool is started again for the
+others); a Dask cluster's workers need no shared file system (the case files come back to this machine).
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ def _lost(task: CaseTask, exc: BaseException) -> CaseOutcome:
     return CaseOutcome(task.name, FAILED, True, f"worker lost: {type(exc).__name__}: {exc}")
 
 
-MAX_POOL_REBUILDS = 5  # a worker that dies takes its case with it; after this many deaths the rest is not tried
+MAX_POOL_REBUILDS = 5  # pools started again in one run after a worker died; at the next death the rest fails
 IDLE = -1  # a worker slot's task index between cases
 _board, _slot = None, -1  # in a pool process: the pool's board of (pid, running task index) and this process's slot
 
@@ -166,7 +168,8 @@ class LocalPool:
         # on an empty kernel cache the first case runs alone: its process compiles the kernels (with the
         # compile-ahead helper on the second core) and every other case loads them, instead of each process
         # compiling them at once on shared cores (a 2-worker sweep's first cases: 17 → 13 s)
-        held_back = list(range(1, len(tasks))) if len(tasks) > 1 and self.workers > 1 and precompile.cache_is_cold() else []
+        compile_first = len(tasks) > 1 and self.workers > 1 and precompile.cache_is_cold()
+        held_back = list(range(1, len(tasks))) if compile_first else []
         batch.submit(range(len(tasks) - len(held_back)))
         interrupted = False
         try:
@@ -282,8 +285,8 @@ def check_address(address: str) -> str:
 
 
 class DaskCluster:
-    """An existing dask.distributed cluster at `address` (tcp://host:8786); its workers need clearsim installed
-    (and the CSV tables the mechanism reads, at the same path); the result files come back to this machine."""
+    """An existing dask.distributed cluster at `address` (tcp://host:8786); its workers need clearsim installed,
+    not the sweep folder: the CSV tables go with each case, the result files come back to this machine."""
 
     def __init__(self, address: str, workers: int | None = None):
         if workers is not None:

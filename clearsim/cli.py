@@ -208,7 +208,7 @@ def sweep(
     seed: int = typer.Option(0, "--seed", help="Seed of the Monte Carlo draws."),
     workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes (default: all cores)."),
     scheduler: Optional[str] = typer.Option(
-        None, "--scheduler", help="Run on an existing Dask cluster: tcp://host:8786 (shared file system)."),
+        None, "--scheduler", help="Run on an existing Dask cluster: tcp://host:8786 (the result files come back here)."),
     out: Optional[Path] = typer.Option(
         None, "-o", "--out", help="Sweep folder (default: results/sweep-<config>-<hash>/); re-running resumes."),
     no_ideal: bool = typer.Option(False, "--no-ideal", help="Leave out the ideal (no-clearance) reference case."),

@@ -3,6 +3,8 @@
 Both hand each outcome to a callback as its case finishes. Ctrl-C cancels the cases not yet
 started; cases already running in the pool are interrupted (their files flagged incomplete) and
 their outcomes still collected, so the summary matches the files. A second Ctrl-C leaves at once.
+A process of the local pool that dies fails only the case it was running (the pool is started again for the
+others); a Dask cluster's workers need no shared file system (the case files come back to this machine).
 """
 
 from __future__ import annotations
@@ -10,13 +12,20 @@ from __future__ import annotations
 import multiprocessing
 import os
 import signal
+import tempfile
 import uuid
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Callable, Sequence
 
+from clearsim.errors import ClearsimError
+from clearsim.io.hdf5 import keep_as_previous
 from clearsim.solver import precompile
 from clearsim.sweep.grid import SweepOptionError
-from clearsim.sweep.worker import FAILED, CaseOutcome, CaseTask, init_pool_worker
+from clearsim.sweep.worker import (FAILED, INTERRUPTED, CaseOutcome, CaseTask, init_pool_worker, load_case,
+                                   reused_outcome)
 
 Collect = Callable[[CaseOutcome], None]
 MAX_WORKERS_PER_CORE = 4  # a case is compiled code using one core: more processes only add memory
@@ -34,6 +43,69 @@ def _lost(task: CaseTask, exc: BaseException) -> CaseOutcome:
     return CaseOutcome(task.name, FAILED, True, f"worker lost: {type(exc).__name__}: {exc}")
 
 
+MAX_POOL_REBUILDS = 5  # pools started again in one run after a worker died; at the next death the rest fails
+IDLE = -1  # a worker slot's task index between cases
+_board, _slot = None, -1  # in a pool process: the pool's board of (pid, running task index) and this process's slot
+
+
+@dataclass
+class _Pool:
+    """A process pool, its stop flag, and its board: per worker process, its pid and the index of the task it runs
+    (shared memory, so that when a process dies the case it was running is known: a broken pool fails every
+    pending future alike)."""
+
+    executor: ProcessPoolExecutor
+    stop: object
+    board: object = None
+
+
+def _init_worker(stop, board, next_slot) -> None:
+    """Pool initializer: the case worker's, then this process's slot on the board."""
+    global _board, _slot
+    init_pool_worker(stop)
+    with next_slot.get_lock():
+        _slot, next_slot.value = next_slot.value, next_slot.value + 1
+    if 2 * _slot + 1 < len(board):
+        _board = board
+        _board[2 * _slot], _board[2 * _slot + 1] = os.getpid(), IDLE
+
+
+def _tracked(function: Callable, index: int, task):
+    """Run one task, its index on the board while it runs (a process killed mid-case leaves it there)."""
+    if _board is not None:
+        _board[2 * _slot + 1] = index
+    try:
+        return function(task)
+    finally:
+        if _board is not None:
+            _board[2 * _slot + 1] = IDLE
+
+
+def _death(exitcode: int) -> str:
+    if exitcode < 0:
+        try:
+            return f"worker killed by signal {-exitcode} ({signal.Signals(-exitcode).name})"
+        except ValueError:
+            return f"worker killed by signal {-exitcode}"
+    return f"worker process exited with code {exitcode}"
+
+
+def _running(board) -> dict[int, int]:
+    """pid → index of the task it was running, for the board's busy slots."""
+    if board is None:
+        return {}
+    pairs = zip(board[0::2], board[1::2])
+    return {pid: index for pid, index in pairs if pid > 0 and index != IDLE}
+
+
+def _deaths(processes: dict, running: dict[int, int]) -> dict[int, str]:
+    """Task index → why its worker died, for the processes that died by themselves while running a case (once one
+    dies, the pool ends the others with SIGTERM)."""
+    codes = {pid: process.exitcode for pid, process in processes.items()}
+    return {index: _death(codes[pid]) for pid, index in running.items()
+            if codes.get(pid) is not None and codes[pid] != -signal.SIGTERM}
+
+
 class LocalPool:
     """A pool of `workers` processes (default: all cores), each running many cases."""
 
@@ -47,7 +119,7 @@ class LocalPool:
                                    "only share them, and each holds its own copy of the compiled kernels (~200 MB)\n"
                                    f"  hint: --workers {cores}, or leave the option out (one process per core)")
         self.workers = workers or available_cores()
-        self._pool, self._stop = None, None
+        self._pool: _Pool | None = None
 
     def describe(self) -> str:
         return f"{self.workers} local worker process{'es' if self.workers > 1 else ''}"
@@ -58,13 +130,13 @@ class LocalPool:
     def open(self) -> "LocalPool":
         """Keep the worker processes between `run` calls (diagnose runs many small batches) until `close`."""
         if self._pool is None:
-            self._pool, self._stop = self._start(self.workers)
+            self._pool = self._start(self.workers)
         return self
 
     def close(self) -> None:
         if self._pool is not None:
-            self._pool.shutdown(wait=True, cancel_futures=True)
-            self._pool, self._stop = None, None
+            self._pool.executor.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
 
     def __enter__(self) -> "LocalPool":
         return self.open()
@@ -73,55 +145,102 @@ class LocalPool:
         self.close()
 
     @staticmethod
-    def _start(workers: int):
+    def _start(workers: int) -> _Pool:
         # spawn, not fork: the parent may hold threads (the progress bar) and numba state
         context = multiprocessing.get_context("spawn")
-        stop = context.Event()
-        pool = ProcessPoolExecutor(workers, mp_context=context, initializer=init_pool_worker, initargs=(stop,))
-        return pool, stop
+        stop, board, next_slot = context.Event(), context.Array("q", 2 * workers, lock=False), context.Value("i", 0)
+        executor = ProcessPoolExecutor(workers, mp_context=context, initializer=_init_worker,
+                                       initargs=(stop, board, next_slot))
+        return _Pool(executor, stop, board)
 
     def run(self, function: Callable, tasks: Sequence[CaseTask], collect: Collect) -> bool:
-        """Run every task, passing each outcome to `collect`; True when Ctrl-C stopped the sweep."""
+        """Run every task, passing each outcome to `collect`; True when Ctrl-C stopped the sweep.
+
+        A worker process that dies (killed, out of memory) breaks the pool: its case is recorded as failed with the
+        reason, the pool is started again and the cases that were queued or running on the other processes are
+        submitted again (at most MAX_POOL_REBUILDS times)."""
         if not tasks:
             return False
         kept = self._pool is not None
-        pool, stop = (self._pool, self._stop) if kept else self._start(min(self.workers, len(tasks)))
-        stop.clear()
+        size = self.workers if kept else min(self.workers, len(tasks))
+        batch = _Batch(self._pool if kept else self._start(size), function, tasks, collect, lambda: self._start(size))
+        batch.pool.stop.clear()
         # on an empty kernel cache the first case runs alone: its process compiles the kernels (with the
         # compile-ahead helper on the second core) and every other case loads them, instead of each process
         # compiling them at once on shared cores (a 2-worker sweep's first cases: 17 → 13 s)
-        held_back = list(tasks[1:]) if len(tasks) > 1 and self.workers > 1 and precompile.cache_is_cold() else []
-        futures = {pool.submit(function, task): task for task in tasks[:len(tasks) - len(held_back)]}
-        remaining, interrupted = set(futures), False
+        compile_first = len(tasks) > 1 and self.workers > 1 and precompile.cache_is_cold()
+        held_back = list(range(1, len(tasks))) if compile_first else []
+        batch.submit(range(len(tasks) - len(held_back)))
+        interrupted = False
         try:
-            while remaining:
+            while batch.futures or held_back:
                 try:
-                    _collect_finished(futures, remaining, collect)
+                    batch.collect_finished(interrupted)
                     if held_back and not interrupted:
-                        submitted = {pool.submit(function, task): task for task in held_back}
-                        futures.update(submitted)
-                        remaining.update(submitted)
+                        batch.submit(held_back)
                         held_back = []
                 except KeyboardInterrupt:
                     if interrupted:
                         raise  # a second Ctrl-C: leave without waiting for the running cases
-                    interrupted = True
-                    stop.set()  # cases already handed to a process return at once instead of starting
-                    _interrupt_workers(pool)
-                    remaining = {future for future in remaining if not future.cancel()}
+                    interrupted, held_back = True, []
+                    batch.pool.stop.set()  # cases already handed to a process return at once instead of starting
+                    _interrupt_workers(batch.pool.executor)
+                    batch.futures = {future: i for future, i in batch.futures.items() if not future.cancel()}
         finally:
             if not kept or interrupted:
-                pool.shutdown(wait=True, cancel_futures=True)
-                if kept:
-                    self._pool, self._stop = None, None
+                batch.pool.executor.shutdown(wait=True, cancel_futures=True)
+            if kept:
+                self._pool = None if interrupted else batch.pool
         return interrupted
 
 
-def _collect_finished(futures: dict, remaining: set, collect: Collect) -> None:
-    done, _ = wait(remaining, return_when=FIRST_COMPLETED)
-    for future in done:
-        remaining.discard(future)
-        collect(_result(future, futures[future]))
+class _Batch:
+    """The tasks of one `LocalPool.run` in flight on a pool, and the pool rebuilt when one of its workers dies."""
+
+    def __init__(self, pool: _Pool, function: Callable, tasks: Sequence[CaseTask], collect: Collect,
+                 new_pool: Callable[[], _Pool]):
+        self.pool, self.function, self.tasks, self.collect, self.new_pool = pool, function, tasks, collect, new_pool
+        self.futures: dict = {}  # future → task index
+        self.rebuilds = 0
+
+    def submit(self, indices) -> None:
+        for index in indices:
+            self.futures[self.pool.executor.submit(_tracked, self.function, index, self.tasks[index])] = index
+
+    def collect_finished(self, interrupted: bool) -> None:
+        done, _ = wait(self.futures, return_when=FIRST_COMPLETED)
+        if any(isinstance(future.exception(), BrokenProcessPool) for future in done):
+            self._recover(interrupted)
+            return
+        for future in done:
+            self.collect(_result(future, self.tasks[self.futures.pop(future)]))
+
+    def _recover(self, interrupted: bool) -> None:
+        """A worker died: every pending future failed alike. The case the dead process was running fails with the
+        reason; the others run again on a new pool. A process ended by SIGTERM looks like the ones the pool ends
+        itself: then no case is blamed and every one runs again (MAX_POOL_REBUILDS bounds the repeats)."""
+        processes = dict(self.pool.executor._processes or {})
+        self.pool.executor.shutdown(wait=True)  # the pool has ended its processes: their exit codes are known
+        # read once they have ended: a process that the pool's SIGTERM reached while writing its file ends its
+        # case in order (clearing its slot) and exits with code 0
+        deaths = _deaths(processes, _running(self.pool.board))
+        self.rebuilds += 1
+        again = []
+        for future, index in sorted(self.futures.items(), key=lambda item: item[1]):
+            task, exc = self.tasks[index], future.exception()
+            if not isinstance(exc, BrokenProcessPool):
+                self.collect(_result(future, task))
+            elif index in deaths:
+                self.collect(CaseOutcome(task.name, FAILED, True, f"{deaths[index]} while running this case"))
+            elif interrupted:
+                self.collect(CaseOutcome(task.name, INTERRUPTED, True, "interrupted"))
+            elif self.rebuilds > MAX_POOL_REBUILDS:
+                self.collect(CaseOutcome(task.name, FAILED, True, f"not run: worker processes died "
+                                         f"{self.rebuilds} times in this sweep, the pool was not started again"))
+            else:
+                again.append(index)
+        self.futures, self.pool = {}, self.new_pool()  # its processes start with the first case submitted
+        self.submit(again)
 
 
 def _interrupt_workers(pool: ProcessPoolExecutor) -> None:
@@ -166,8 +285,8 @@ def check_address(address: str) -> str:
 
 
 class DaskCluster:
-    """An existing dask.distributed cluster at `address` (tcp://host:8786); its workers need clearsim
-    installed and the sweep folder on a shared file system at the same path."""
+    """An existing dask.distributed cluster at `address` (tcp://host:8786); its workers need clearsim installed,
+    not the sweep folder: the CSV tables go with each case, the result files come back to this machine."""
 
     def __init__(self, address: str, workers: int | None = None):
         if workers is not None:
@@ -202,20 +321,96 @@ class DaskCluster:
                                    "  hint: start one with `dask scheduler` and workers with `dask worker ADDRESS`") from None
 
     def run(self, function: Callable, tasks: Sequence[CaseTask], collect: Collect) -> bool:
-        """As LocalPool.run; on Ctrl-C the cases not started are cancelled, running ones finish on the cluster."""
+        """As LocalPool.run, without a shared file system: whether a case's file is there to reuse is decided
+        here, each case runs in a scratch folder of its worker, and its file comes back with its outcome and is
+        written into the sweep folder here. On Ctrl-C the cases not started are cancelled; the results of
+        running ones are not waited for (those cases run again on resume)."""
         from distributed import as_completed
 
         self.connect()
         client, self.client = self.client, None
-        futures, token = {}, uuid.uuid4().hex[:8]
+        futures, token, read = {}, uuid.uuid4().hex[:8], {}
         try:
             for task in tasks:
-                futures[client.submit(function, task, key=f"clearsim-{token}-{task.name}", pure=False)] = task
+                if (reused := _reused_here(task)) is not None:
+                    collect(reused)
+                    continue
+                shipped = replace(task, output=Path(task.output).name)  # the worker's scratch folder holds it
+                futures[client.submit(run_shipped, function, shipped, _tables(task, read),
+                                      key=f"clearsim-{token}-{task.name}", pure=False)] = task
             for future in as_completed(list(futures)):
-                collect(_result(future, futures[future]))
+                task = futures.pop(future)
+                collect(_received(task, future))
         except KeyboardInterrupt:
             return True
         finally:
             client.cancel(list(futures))
             client.close()
         return False
+
+
+def _reused_here(task: CaseTask) -> CaseOutcome | None:
+    """The case's outcome when the sweep folder holds its result already (the folder made ready otherwise)."""
+    try:
+        return reused_outcome(task)
+    except ClearsimError as exc:
+        return CaseOutcome(task.name, FAILED, True, str(exc))
+
+
+def _tables(task: CaseTask, read: dict[Path, bytes]) -> dict[str, bytes]:
+    """The CSV tables the case reads (every `file:` of its mechanism, relative to the YAML file), to go with it to
+    a worker that does not see them; none when one is missing here (the worker then reports it at its path here).
+    `read` keeps the bytes of those read already."""
+    base = Path(task.base_dir)
+    names = {name for name in _file_keys(load_case(task).mechanism.model_dump()) if not Path(name).is_absolute()}
+    for path in {base / name for name in names} - set(read):
+        read[path] = path.read_bytes() if path.is_file() else None
+    tables = {name: read[base / name] for name in sorted(names)}
+    return tables if None not in tables.values() else {}
+
+
+def _file_keys(value) -> list[str]:
+    if isinstance(value, dict):
+        return [item for key, inner in value.items()
+                for item in ([inner] if key == "file" and isinstance(inner, str) else _file_keys(inner))]
+    if isinstance(value, list):
+        return [item for inner in value for item in _file_keys(inner)]
+    return []
+
+
+def run_shipped(function: Callable, task: CaseTask, tables: dict[str, bytes]) -> tuple[CaseOutcome, bytes | None]:
+    """On a worker: the case with its file in a scratch folder of this machine, and its CSV tables there beside a
+    stand-in for the YAML file's folder (all of them, or none when a name climbs out of the scratch folder: then
+    they are read at the YAML file's folder); its outcome and the file's bytes (None when it wrote none) go back
+    to the machine that holds the sweep folder."""
+    with tempfile.TemporaryDirectory(prefix="clearsim-case-") as scratch:
+        output, base = Path(scratch) / task.output, Path(scratch) / "config"
+        placed = {(base / name).resolve(): data for name, data in tables.items()}
+        sent = bool(placed) and all(path.is_relative_to(Path(scratch).resolve()) for path in placed)
+        for path, data in placed.items() if sent else ():
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data)
+        outcome = function(replace(task, output=str(output), base_dir=str(base) if sent else task.base_dir))
+        return outcome, output.read_bytes() if output.exists() else None
+
+
+def _received(task: CaseTask, future) -> CaseOutcome:
+    """A case's outcome from the cluster, its file written into the sweep folder (a file already there is kept as
+    .previous, never overwritten); a file that cannot be written fails the case with the reason."""
+    try:
+        outcome, data = future.result()
+    except Exception as exc:
+        return _lost(task, exc)
+    if data is None:
+        return outcome
+    output = Path(task.output)
+    partial = output.with_name(output.name + ".part")
+    try:
+        partial.write_bytes(data)
+        keep_as_previous(output)
+        partial.replace(output)
+    except OSError as exc:
+        partial.unlink(missing_ok=True)
+        return CaseOutcome(task.name, FAILED, True, f"its result file ({len(data) / 1e6:.1f} MB) came back from "
+                                                    f"the cluster but cannot be written to {output}: {exc}")
+    return outcome

@@ -105,11 +105,11 @@ def _attempt_recorded(task: CaseTask) -> CaseOutcome:
 
 
 def _attempt(task: CaseTask) -> CaseOutcome:
-    loaded = load_mechanism_text(task.config_text, task.config_name, task.overrides, Path(task.base_dir))
+    loaded = load_case(task)
     output = Path(task.output)
     output_sensors = loaded.mechanism.output
-    if _reusable(output, loaded.resolved_yaml, task.retry_failed, task.contents):
-        return _outcome(task.name, output, output_sensors, ran=False)
+    if (reused := _reused(task, loaded)) is not None:
+        return reused
     system = prepare(loaded)
     report = run_to_file(system, loaded, output, contents=task.contents)
     if isinstance(report.error, KeyboardInterrupt):
@@ -117,6 +117,24 @@ def _attempt(task: CaseTask) -> CaseOutcome:
     if isinstance(report.error, ResultWriteError):
         raise report.error  # a failed case, with the reason; its file may not be readable
     return _outcome(task.name, output, output_sensors, ran=True)
+
+
+def load_case(task: CaseTask):
+    """The case's mechanism: the YAML text with its overrides (CSV tables are read from base_dir when it runs)."""
+    return load_mechanism_text(task.config_text, task.config_name, task.overrides, Path(task.base_dir))
+
+
+def reused_outcome(task: CaseTask) -> CaseOutcome | None:
+    """The outcome of the case's existing file when it is this case's result (a re-run reuses it), else None with
+    the folder made ready for a new file (an unusable one removed, one of another YAML kept as .previous): where
+    the sweep folder is, for a case that runs on a machine that does not see it."""
+    return _reused(task, load_case(task))
+
+
+def _reused(task: CaseTask, loaded) -> CaseOutcome | None:
+    if _reusable(Path(task.output), loaded.resolved_yaml, task.retry_failed, task.contents):
+        return _outcome(task.name, Path(task.output), loaded.mechanism.output, ran=False)
+    return None
 
 
 def _after_interrupt(task: CaseTask) -> CaseOutcome:
@@ -127,7 +145,7 @@ def _after_interrupt(task: CaseTask) -> CaseOutcome:
 def finished_outcome(task: CaseTask) -> CaseOutcome | None:
     """The case's outcome read from its file when that is complete and of this case's YAML, else None."""
     try:
-        loaded = load_mechanism_text(task.config_text, task.config_name, task.overrides, Path(task.base_dir))
+        loaded = load_case(task)
         output = Path(task.output)
         if not output.exists():
             return None

@@ -206,14 +206,14 @@ def test_a_case_run_at_a_tolerance_too_coarse_for_its_contacts_is_named_with_its
 # --- an empty kernel cache: the first case alone ---------------------------------------------------------------
 
 
-class _ThreadPool:
+def _thread_pool(workers: int):
     """LocalPool's pool in threads, for the order of starts and ends (cases here are plain functions)."""
+    import threading
+    from concurrent.futures import ThreadPoolExecutor
 
-    def __init__(self, workers: int):
-        import threading
-        from concurrent.futures import ThreadPoolExecutor
+    from clearsim.sweep import executors
 
-        self.executor, self.stop = ThreadPoolExecutor(workers), threading.Event()
+    return executors._Pool(ThreadPoolExecutor(workers), threading.Event())
 
 
 @pytest.mark.parametrize("cold", [True, False], ids=["empty cache", "filled cache"])
@@ -236,8 +236,7 @@ def test_on_an_empty_kernel_cache_the_first_case_runs_alone(monkeypatch, cold):
         return CaseOutcome(task, COMPLETE, True, "")
 
     monkeypatch.setattr(precompile, "cache_is_cold", lambda: cold)
-    monkeypatch.setattr(executors.LocalPool, "_start", staticmethod(
-        lambda workers: (lambda pool: (pool.executor, pool.stop))(_ThreadPool(workers))))
+    monkeypatch.setattr(executors.LocalPool, "_start", staticmethod(_thread_pool))
     collected = []
     assert not LocalPool(2).run(case, ["a", "b", "c"], collected.append)
     assert sorted(outcome.name for outcome in collected) == ["a", "b", "c"]

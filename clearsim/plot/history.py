@@ -10,11 +10,14 @@ import numpy as np
 
 from clearsim.plot.data import RunData
 from clearsim.plot.scales import FREQUENCY, TIME, scale_for
-from clearsim.plot.style import axes_or_new, new_figure, run_style, set_title, title_of
+from clearsim.plot.style import (LEGEND_WIDTH, axes_or_new, legend_beside, new_figure, overlay_styles, set_title,
+                                 title_of)
 
 ENERGY_KINDS = ("kinetic", "potential", "driver_work", "applied_work", "contact_dissipated",
                 "friction_dissipated", "damping_dissipated")
 VIOLATION_FLOOR = 1e-18  # m: stands for an exact zero on the logarithmic axis
+SPECTRUM_RANGE = 1e-8  # amplitudes below the highest peak × this are numerical floor (of an ideal run): not shown
+SPECTRUM_FLOOR_PERCENTILE = 1.0  # the amplitude axis starts at a third of this percentile of the clearance runs
 ENVELOPE_BINS = 300  # the violation jumps between 0 (just projected) and ~1e-13 m: draw its envelope
 
 
@@ -32,19 +35,24 @@ def plot_signal(runs: list[RunData], sensor: str, ax=None):
     """A sensor against time, one line per run, in engineering units."""
     ax = axes_or_new(ax)
     scale = _sensor_scale(runs, sensor)
-    for run in runs:
-        ax.plot(TIME(run.time), scale(run.series(f"sensors/{sensor}")), label=run.label or run.name,
-                **run_style(run))
+    series = [run.series(f"sensors/{sensor}") for run in runs]
+    for run, values, style in zip(runs, series, overlay_styles(runs, [_peak_to_peak(v) for v in series])):
+        ax.plot(TIME(run.time), scale(values), label=run.label or run.name, **style)
     ax.set_ylabel(scale.label(pretty(sensor)))
     ax.set_xlabel(TIME.label("time"))
     if len(runs) > 1:
-        ax.legend(loc="best")
+        legend_beside(ax)
     return ax
+
+
+def _peak_to_peak(values) -> float:
+    values = np.asarray(values, dtype=float)
+    return float(np.ptp(values[np.isfinite(values)])) if np.any(np.isfinite(values)) else float("nan")
 
 
 def signals_figure(runs: list[RunData], sensors: list[str], interactive: bool = False):
     """One axis per sensor, stacked with a shared time axis (paper Fig. 7/8: x, v, a of the output)."""
-    figure = new_figure((8.0, 2.3 * len(sensors) + 0.8), interactive)
+    figure = new_figure((8.0 + (LEGEND_WIDTH if len(runs) > 1 else 0.0), 2.3 * len(sensors) + 0.8), interactive)
     axes = figure.subplots(len(sensors), 1, sharex=True, squeeze=False)[:, 0]
     for ax, sensor in zip(axes, sensors):
         plot_signal(runs, sensor, ax)
@@ -72,19 +80,45 @@ def plot_spectrum(runs: list[RunData], sensor: str, ax=None):
     """Amplitude spectrum of a sensor, frequency in kHz, logarithmic amplitude."""
     ax = axes_or_new(ax)
     unit = scale_for(runs[0].unit(f"sensors/{sensor}"), [1.0]).unit
-    for run in runs:
-        frequency, amplitude = amplitude_spectrum(run.time, run.series(f"sensors/{sensor}"))
-        ax.semilogy(FREQUENCY(frequency[1:]), amplitude[1:], label=run.label or run.name, **run_style(run))
+    spectra = [amplitude_spectrum(run.time, run.series(f"sensors/{sensor}")) for run in runs]
+    spectra = [(frequency[1:], amplitude[1:]) for frequency, amplitude in spectra]
+    for run, (frequency, amplitude), style in zip(runs, spectra, overlay_styles(runs, [_top(a) for _, a in spectra])):
+        ax.semilogy(FREQUENCY(frequency), amplitude, label=run.label or run.name, **style)
     ax.set_xlabel(FREQUENCY.label("frequency"))
     ax.set_ylabel(f"amplitude of {pretty(sensor)} ({unit})")
     ax.set_xlim(left=0.0)
+    limits = spectrum_limits([amplitude for _, amplitude in spectra], [not run.clearance_joints for run in runs])
+    if limits is not None:
+        ax.set_ylim(*limits)
     if len(runs) > 1:
-        ax.legend(loc="best")
+        legend_beside(ax)
     return ax
 
 
+def _top(values) -> float:
+    finite = np.asarray(values, dtype=float)[np.isfinite(values)]
+    return float(np.max(finite)) if finite.size else float("nan")
+
+
+def spectrum_limits(amplitudes: list[np.ndarray], ideal: list[bool]) -> tuple[float, float] | None:
+    """Amplitude axis limits from the informative data: up to twice the highest peak, down to a third of the
+    SPECTRUM_FLOOR_PERCENTILE-th percentile of the runs with clearance (of every run when all are ideal), never
+    below the peak × SPECTRUM_RANGE — an ideal run's smooth spectrum falls to a numerical floor far below."""
+    def positive(values):
+        values = np.asarray(values, dtype=float)
+        return values[np.isfinite(values) & (values > 0.0)]
+
+    every = [positive(a) for a in amplitudes]
+    informative = [a for a, is_ideal in zip(every, ideal) if not is_ideal and a.size] or [a for a in every if a.size]
+    if not informative:
+        return None
+    top = max(float(np.max(a)) for a in every if a.size)
+    low = float(np.percentile(np.concatenate(informative), SPECTRUM_FLOOR_PERCENTILE)) / 3.0
+    return max(low, top * SPECTRUM_RANGE), top * 2.0
+
+
 def spectrum_figure(runs: list[RunData], sensors: list[str], interactive: bool = False):
-    figure = new_figure((8.0, 2.6 * len(sensors) + 0.9), interactive)
+    figure = new_figure((8.0 + (LEGEND_WIDTH if len(runs) > 1 else 0.0), 2.6 * len(sensors) + 0.9), interactive)
     axes = figure.subplots(len(sensors), 1, squeeze=False)[:, 0]
     for ax, sensor in zip(axes, sensors):
         plot_spectrum(runs, sensor, ax)
@@ -109,23 +143,22 @@ def plot_energies(run: RunData, ax=None):
         ax.plot(TIME(run.time), values, label=label)
     ax.set_ylabel("energy (J)")
     ax.set_xlabel(TIME.label("time"))
-    if ax.lines:  # a file without energies: an empty panel, not a matplotlib warning
-        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    legend_beside(ax)  # none for a file without energies (an empty panel, not a matplotlib warning)
     return ax
 
 
 def plot_balance_error(runs: list[RunData], ax=None):
     """The energy balance error E − E(0) − W + D (J): zero for exact integration."""
     ax = axes_or_new(ax)
-    for run in runs:
-        error = run.series("energy/balance_error", "the energy balance")
+    errors = [run.series("energy/balance_error", "the energy balance") for run in runs]
+    peaks = [float(np.max(np.abs(error))) for error in errors]
+    for run, error, peak, style in zip(runs, errors, peaks, overlay_styles(runs, peaks)):
         reference = max(float(np.max(np.abs(run.series("energy/kinetic", "the energy balance")))), 1e-300)
-        label = f"{run.label or run.name}: max |error| {np.max(np.abs(error)):.3g} J " \
-                f"({np.max(np.abs(error)) / reference:.2g} of peak kinetic energy)"
-        ax.plot(TIME(run.time), error, label=label, **run_style(run))
+        label = f"{run.label or run.name}: max |error| {peak:.3g} J ({peak / reference:.2g} of peak kinetic energy)"
+        ax.plot(TIME(run.time), error, label=label, **style)
     ax.set_ylabel("balance error (J)")
     ax.set_xlabel(TIME.label("time"))
-    ax.legend(loc="best")
+    legend_beside(ax)
     return ax
 
 
@@ -142,21 +175,22 @@ def envelope(time: np.ndarray, values: np.ndarray, bins: int) -> tuple[np.ndarra
 def plot_violation(runs: list[RunData], ax=None):
     """max |Φ| of the ideal joints (m), logarithmic: its upper envelope over ENVELOPE_BINS bins."""
     ax = axes_or_new(ax)
-    for run in runs:
-        violation = run.series("constraints/violation", "the constraint violation")
-        time, peaks = envelope(run.time, violation, ENVELOPE_BINS)
-        ax.semilogy(TIME(time), np.maximum(peaks, VIOLATION_FLOOR),
-                    label=f"{run.label or run.name}: max {np.max(violation):.2g} m", **run_style(run))
+    violations = [run.series("constraints/violation", "the constraint violation") for run in runs]
+    peaks = [float(np.max(violation)) for violation in violations]
+    for run, violation, peak, style in zip(runs, violations, peaks, overlay_styles(runs, peaks)):
+        time, envelope_peaks = envelope(run.time, violation, ENVELOPE_BINS)
+        ax.semilogy(TIME(time), np.maximum(envelope_peaks, VIOLATION_FLOOR), label=f"{run.label or run.name}: max "
+                    f"{peak:.2g} m", **style)
     ax.set_ylabel("constraint violation\nmax |Φ| (m)")
     ax.set_xlabel(TIME.label("time"))
-    ax.legend(loc="best")
+    legend_beside(ax)
     return ax
 
 
 def energy_figure(runs: list[RunData], interactive: bool = False):
     """Diagnostic page: energies (one run), balance error and constraint violation (all runs)."""
     panels = 3 if len(runs) == 1 else 2
-    figure = new_figure((8.0, 2.5 * panels + 0.8), interactive)
+    figure = new_figure((8.0 + LEGEND_WIDTH, 2.5 * panels + 0.8), interactive)
     axes = figure.subplots(panels, 1, sharex=True)
     if panels == 3:
         plot_energies(runs[0], axes[0])

@@ -14,8 +14,8 @@ from matplotlib.patches import Circle
 
 from clearsim.plot.data import RunData, check_joint
 from clearsim.plot.scales import TIME, force_scale, length_scale
-from clearsim.plot.style import (MODE_COLOURS, axes_or_new, mode_handles, new_figure, run_style, set_title,
-                                 title_of)
+from clearsim.plot.style import (LEGEND_WIDTH, MODE_COLOURS, axes_or_new, legend_beside, mode_handles, new_figure,
+                                 overlay_styles, set_title, title_of)
 
 PATH_GID = "journal-path"  # lets tests and callers find the drawn path
 MAX_PATH_PANELS = 4
@@ -72,11 +72,12 @@ def shade_modes(run: RunData, joint: str, ax) -> None:
 
 
 def _plot_joint_series(runs: list[RunData], joint: str, name: str, scale, ax):
-    for run in runs:
-        values = run.series(f"joints/{joint}/{name}")
-        if name == "penetration":
-            values = np.maximum(values, 0.0)
-        ax.plot(TIME(run.time), scale(values), label=run.label or run.name, **run_style(run))
+    series = [run.series(f"joints/{joint}/{name}") for run in runs]
+    if name == "penetration":
+        series = [np.maximum(values, 0.0) for values in series]
+    peaks = [float(np.max(np.abs(values), initial=0.0)) for values in series]
+    for run, values, style in zip(runs, series, overlay_styles(runs, peaks)):
+        ax.plot(TIME(run.time), scale(values), label=run.label or run.name, **style)
     ax.set_xlabel(TIME.label("time"))
     return ax
 
@@ -99,11 +100,11 @@ def plot_friction_force(runs: list[RunData], joint: str, ax=None):
     return _plot_force(runs, joint, "friction_force", "friction force $F_t$", ax)
 
 
-def plot_penetration(runs: list[RunData], joint: str, ax=None):
-    """Penetration δ = |e| − c where positive (in contact); 0 in free flight."""
+def plot_penetration(runs: list[RunData], joint: str, ax=None, scale=None):
+    """Penetration δ = |e| − c where positive (in contact); 0 in free flight; in `scale` (default: from δ)."""
     ax = axes_or_new(ax)
     values = np.concatenate([np.maximum(run.series(f"joints/{joint}/penetration"), 0.0) for run in runs])
-    scale = length_scale([max(float(np.max(values, initial=0.0)), 1e-9)])
+    scale = scale or length_scale([max(float(np.max(values, initial=0.0)), 1e-9)])
     _plot_joint_series(runs, joint, "penetration", scale, ax)
     ax.set_ylabel(scale.label(r"penetration $\delta$"))
     ax.set_ylim(bottom=0.0)
@@ -114,11 +115,11 @@ def _has_friction(runs: list[RunData], joint: str) -> bool:
     return any(np.any(run.series(f"joints/{joint}/friction_force")) for run in runs)
 
 
-def _time_panels(runs: list[RunData], joint: str, axes) -> None:
+def _time_panels(runs: list[RunData], joint: str, axes, length) -> None:
     plot_contact_forces(runs, joint, axes[0])
     if len(axes) == 3:
         plot_friction_force(runs, joint, axes[1])
-    plot_penetration(runs, joint, axes[-1])
+    plot_penetration(runs, joint, axes[-1], length)
     for ax in axes[:-1]:
         ax.set_xlabel("")
         ax.tick_params(labelbottom=False)
@@ -126,16 +127,17 @@ def _time_panels(runs: list[RunData], joint: str, axes) -> None:
         for ax in axes:
             shade_modes(runs[0], joint, ax)
     else:
-        axes[0].legend(loc="upper right")
+        legend_beside(axes[0])
 
 
 def _joint_layout(paths: int, rows: int, interactive: bool):
-    """(figure, path axes, time axes): one path beside the time panels, or a row of paths above them."""
+    """(figure, path axes, time axes): one path beside the time panels, or a row of paths above them (and the
+    legend of the runs beside the time panels)."""
     if paths == 1:
         figure = new_figure((10.0, 6.0), interactive)
         grid = figure.add_gridspec(rows, 2, width_ratios=(1.0, 1.25))
         return figure, [figure.add_subplot(grid[:, 0])], [figure.add_subplot(grid[row, 1]) for row in range(rows)]
-    figure = new_figure((max(9.0, 3.0 * paths), 10.0), interactive)
+    figure = new_figure((max(9.0, 3.0 * paths) + LEGEND_WIDTH, 10.0), interactive)
     grid = figure.add_gridspec(rows + 1, paths, height_ratios=(1.6,) + (1.0,) * rows)
     return (figure, [figure.add_subplot(grid[0, k]) for k in range(paths)],
             [figure.add_subplot(grid[row, :]) for row in range(1, rows + 1)])
@@ -149,12 +151,13 @@ def joint_figure(runs: list[RunData], joint: str, interactive: bool = False):
     shown = runs[:MAX_PATH_PANELS]
     friction = _has_friction(runs, joint)
     figure, paths, series = _joint_layout(len(shown), 3 if friction else 2, interactive)
+    length = _eccentricity_scale(runs, joint)  # one length unit for every panel
     for run, ax in zip(shown, paths):
-        plot_journal_path(run, joint, ax)
+        plot_journal_path(run, joint, ax, length)
     mode_legend(figure, with_circle=bool(shown[0].clearances.get(joint)), shaded=len(runs) == 1)
     for ax in series[1:]:
         ax.sharex(series[0])
-    _time_panels(runs, joint, series)
+    _time_panels(runs, joint, series, length)
     note = "" if len(runs) <= MAX_PATH_PANELS else f" (paths of the first {MAX_PATH_PANELS} runs)"
     forces = "contact forces" if friction else "normal force (no friction)"
     set_title(figure, f"{title_of(runs[0])}\nclearance joint {joint}: journal centre relative to the bearing, "

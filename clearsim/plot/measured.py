@@ -21,7 +21,8 @@ from clearsim.diagnose.measured import MeasuredData, read_measured
 from clearsim.plot.data import PlotInputError, RunData
 from clearsim.plot.history import pretty
 from clearsim.plot.scales import TIME, scale_for
-from clearsim.plot.style import axes_or_new, new_figure, run_style, set_title, title_of
+from clearsim.plot.style import (LEGEND_WIDTH, axes_or_new, legend_beside, new_figure, run_style, set_title, title_of,
+                                 wrap_label)
 
 MIN_SAMPLES = 2  # a plot needs a line, not a noise estimate
 Measurement = MeasuredData
@@ -61,12 +62,6 @@ def residual(run: RunData, sensor: str, time: np.ndarray, measured: np.ndarray):
     return time[inside], simulated - measured[inside]
 
 
-def wrap_label(text: str, width: int = 24) -> str:
-    import textwrap
-
-    return "\n".join(textwrap.wrap(text, width))
-
-
 def within(measurement: MeasuredData, window: tuple[float, float] | None) -> MeasuredData:
     """The samples of the measurement inside a time window (s)."""
     if window is None:
@@ -96,17 +91,17 @@ def plot_measured(runs: list[RunData], measurement: MeasuredData, sensor: str, a
             residual_ax.plot(TIME(t), scale(r), label=f"{run.label or run.name}: RMS {scale(rms):.3g} {scale.unit}",
                              **run_style(run))
     ax.set_ylabel(wrap_label(scale.label(pretty(sensor))))
-    ax.legend(loc="best")
+    legend_beside(ax)
     if residual_ax is not None:
         residual_ax.axhline(0.0, color="black", linewidth=0.8)
         residual_ax.set_ylabel(wrap_label(scale.label("sim − meas")))
         residual_ax.set_xlabel(TIME.label("time"))
-        residual_ax.legend(loc="best")
+        legend_beside(residual_ax)
     return ax
 
 
 def measured_figure(runs: list[RunData], measurement: MeasuredData, sensors: list[str], interactive: bool = False):
-    figure = new_figure((8.0, 3.6 * len(sensors) + 0.8), interactive)
+    figure = new_figure((8.0 + LEGEND_WIDTH, 3.6 * len(sensors) + 0.8), interactive)
     grid = figure.add_gridspec(2 * len(sensors), 1, height_ratios=[2.0, 1.0] * len(sensors))
     for k, sensor in enumerate(sensors):
         top = figure.add_subplot(grid[2 * k])

@@ -14,11 +14,11 @@ from pathlib import Path
 import numpy as np
 
 from clearsim.plot.data import PlotInputError
-from clearsim.plot.style import IDEAL_STYLE, RUN_COLOURS, axes_or_new, new_figure, set_title
+from clearsim.plot.style import IDEAL_STYLE, RUN_COLOURS, axes_or_new, figure_legend, legend_beside, new_figure, set_title
 
 SUMMARY = "summary.csv"
 BACKUP = re.compile(r"\.previous(-\d+)?\.h5$")  # a case's earlier result, kept by a re-run (docs/sweeps.md §4)
-BOOKKEEPING = {"case", "reference", "status", "error", "reused", "steps", "rejected_steps", "wall_time_s"}
+BOOKKEEPING = {"case", "reference", "status", "error", "warnings", "reused", "steps", "rejected_steps", "wall_time_s"}
 MERITS = {  # column → (axis label, factor from the CSV's unit to the axis unit)
     "peak_acceleration_m_s2": ("peak |output acceleration| (m/s²)", 1.0),
     "start_delay_ms": ("start delay of the output (ms)", 1.0),
@@ -81,7 +81,8 @@ def read_summary(path: Path) -> Summary:
         for p in parameters:
             row[p], units[p] = _number(record.get(p, ""), units[p])
         rows.append(row)
-    return Summary(parameters, {p: u or "" for p, u in units.items()}, rows)
+    swept = [p for p in parameters if any(not math.isnan(row[p]) for row in rows)]  # a column of no quantity: not swept
+    return Summary(swept, {p: units[p] or "" for p in swept}, rows)
 
 
 def _groups(summary: Summary) -> dict:
@@ -99,8 +100,9 @@ def _group_label(summary: Summary, key: tuple) -> str:
     return ", ".join(f"{p} {v:g} {summary.units[p]}".strip() for p, v in zip(summary.parameters[1:], key))
 
 
-def plot_merit(summary: Summary, column: str, ax=None):
-    """A figure of merit against the first swept quantity (one line per combination of the others)."""
+def plot_merit(summary: Summary, column: str, ax=None, legend: bool = True):
+    """A figure of merit against the first swept quantity (one line per combination of the others); the legend
+    beside the axes unless `legend` is False (a figure of several panels has one for all)."""
     ax = axes_or_new(ax)
     label, factor = MERITS[column.split("[")[0]]
     x_name = summary.parameters[0]
@@ -119,8 +121,8 @@ def plot_merit(summary: Summary, column: str, ax=None):
     ax.set_ylabel(label + (f", joint {joint}" if joint else ""))
     unit = summary.units[x_name]
     ax.set_xlabel(f"{x_name} ({unit})" if unit else x_name)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="best")
+    if legend:
+        legend_beside(ax)
     return ax
 
 
@@ -133,7 +135,8 @@ def merit_figure(summary: Summary, title: str, interactive: bool = False):
     figure = new_figure((9.0, 3.0 * rows + 0.8), interactive)
     axes = np.atleast_1d(figure.subplots(rows, 2, squeeze=False).ravel())
     for ax, column in zip(axes, columns):
-        plot_merit(summary, column, ax)
+        plot_merit(summary, column, ax, legend=False)
+    figure_legend(figure, axes[:len(columns)])
     for ax in axes[len(columns):]:
         ax.set_visible(False)
     set_title(figure, f"{title}\nfigures of merit against {summary.parameters[0]} (from summary.csv)")

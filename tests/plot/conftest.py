@@ -20,11 +20,13 @@ def _run(folder: Path, name: str, config: Path, *overrides: str) -> Path:
 
 @pytest.fixture(scope="session")
 def runs(tmp_path_factory) -> dict:
-    """{'clearance': c = 0.5 mm, 'ideal': the same without clearance, 'friction': with Ambrósio friction}."""
+    """{'clearance': c = 0.5 mm, 'ideal': the same without clearance, 'small': c = 0.25 mm, 'tiny': c = 0.05 mm
+    (lengths in µm), 'friction': with Ambrósio friction}."""
     folder = tmp_path_factory.mktemp("runs")
     return {
         "clearance": _run(folder, "sc", SLIDER_CRANK),
         "ideal": _run(folder, "ideal", SLIDER_CRANK, "joints.slider_pin.clearance=0"),
         "small": _run(folder, "small", SLIDER_CRANK, "joints.slider_pin.clearance=0.25mm"),
+        "tiny": _run(folder, "tiny", SLIDER_CRANK, "joints.slider_pin.clearance=0.05mm"),
         "friction": _run(folder, "friction", SLIDER_CRANK_FRICTION),
     }

@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import math
+import textwrap
+from dataclasses import dataclass
 
-from rich.console import Console, Group
+from rich.cells import cell_len
+from rich.console import Console, ConsoleOptions, Group
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.markup import escape
 from rich.table import Table
@@ -55,37 +58,90 @@ def _first_columns(plan: SweepPlan, row: dict) -> list[str]:
     return [f"ideal ({values[0]})" if case.ideal and values[0] != "–" else "ideal", *values[1:]] if case.ideal else values
 
 
-def rich_table(plan: SweepPlan, header: list[str], rows: list[dict]) -> Table:
+GAP = 2  # characters between two columns (rich's padding of one on each side, none at the edges)
+
+
+@dataclass(frozen=True)
+class Column:
+    title: str  # its lines ("\n") wrapped at their spaces when the cells are narrower
+    cells: list[str]  # never split: a number is read whole or not at all
+    justify: str = "right"
+
+    @property
+    def width(self) -> int:
+        return max([cell_len(cell) for cell in self.cells] + [cell_len(word) for word in self.title.split()])
+
+
+def column_blocks(keys: list[Column], columns: list[Column], width: int) -> list[list[Column]]:
+    """The columns in blocks that fit `width` next to the key columns, in order; a column wider than the space left
+    still gets a block of its own."""
+    key_width = sum(key.width + GAP for key in keys)
+    blocks: list[list[Column]] = [[]]
+    used = key_width
+    for column in columns:
+        if blocks[-1] and used + column.width > width:
+            blocks.append([])
+            used = key_width
+        blocks[-1].append(column)
+        used += column.width + GAP
+    return blocks
+
+
+class WholeCellTable:
+    """A table that never splits a cell: each column as wide as its widest cell, and the columns that do not fit the
+    console (80 characters in a pipe) printed in a further block below, the key columns repeated at its left."""
+
+    def __init__(self, keys: list[Column], columns: list[Column]):
+        self.keys, self.columns = keys, columns
+
+    def blocks(self, width: int) -> list[Table]:
+        return [self._table(self.keys + block) for block in column_blocks(self.keys, self.columns, width)]
+
+    @staticmethod
+    def _table(columns: list[Column]) -> Table:
+        table = Table(box=None, pad_edge=False, header_style="bold")
+        for column in columns:
+            title = "\n".join(wrapped for line in column.title.split("\n")
+                              for wrapped in textwrap.wrap(line, column.width, break_long_words=False))
+            table.add_column(escape(title), justify=column.justify, no_wrap=True, min_width=column.width)
+        for row in zip(*(column.cells for column in columns)):
+            table.add_row(*(escape(cell) for cell in row))
+        return table
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions):
+        for number, table in enumerate(self.blocks(options.max_width)):
+            if number:
+                yield ""
+            yield table
+
+
+def rich_table(plan: SweepPlan, header: list[str], rows: list[dict]) -> WholeCellTable:
     """The printed summary: a row per case (for a long sweep the ideal cases and the first ones)."""
     joints = [key[len("max_contact_force_N["):-1] for key in header if key.startswith("max_contact_force_N[")]
-    table = Table(box=None, pad_edge=False, header_style="bold")
-    for title in (["case"] if plan.sampled else plan.labels):
-        table.add_column(escape(title.removeprefix("joints.")), overflow="fold")
-    for title in ["peak |a|\nm/s²", "×\nideal", "delay\nms", "end\nerror %"]:
-        table.add_column(title, justify="right", overflow="fold")
-    for joint in joints:
-        table.add_column(f"F max N\n{escape(joint)}", justify="right", overflow="fold")
-        table.add_column(f"free/imp/cont %\n{escape(joint)}", justify="right", overflow="fold")
-    table.add_column("steps", justify="right", overflow="fold")
-    table.add_column("status", overflow="fold")
     ideal = [r for r in rows if plan.case(r["case"]).ideal]
     shown = rows if len(rows) <= MAX_PRINTED_ROWS else ideal + rows[:MAX_PRINTED_ROWS]
-    for row in list({r["case"]: r for r in shown}.values()):
-        cells = [_number(row.get(key), 3) for key in ("peak_acceleration_m_s2", "acceleration_ratio",
-                                                       "start_delay_ms", "end_error_percent")]
-        per_joint = [c for j in joints for c in (_number(row.get(joint_column("max_contact_force_N", j))), _shares(row, j))]
-        table.add_row(*(escape(text) for text in _first_columns(plan, row)), *cells, *per_joint, _number(row.get("steps")),
-                      "ok" if row["status"] == "complete" else row["status"])
-    return table
+    shown = list({r["case"]: r for r in shown}.values())
+    firsts = [_first_columns(plan, row) for row in shown]
+    keys = [Column(title.removeprefix("joints."), [cells[k] for cells in firsts], "left")
+            for k, title in enumerate(["case"] if plan.sampled else plan.labels)]
+    figures = [("peak |a| m/s²", "peak_acceleration_m_s2"), ("× ideal", "acceleration_ratio"),
+               ("delay ms", "start_delay_ms"), ("end error %", "end_error_percent")]
+    columns = [Column(title, [_number(row.get(key), 3) for row in shown]) for title, key in figures]
+    for joint in joints:
+        columns.append(Column(f"F max N\n{joint}",
+                              [_number(row.get(joint_column("max_contact_force_N", joint))) for row in shown]))
+        columns.append(Column(f"free imp cont %\n{joint}", [_shares(row, joint) for row in shown]))
+    columns.append(Column("steps", [_number(row.get("steps")) for row in shown]))
+    columns.append(Column("status", ["ok" if row["status"] == "complete" else row["status"] for row in shown], "left"))
+    return WholeCellTable(keys, columns)
 
 
-def percentile_table(entries: list[dict]) -> Table:
-    table = Table(box=None, pad_edge=False, header_style="bold")
-    for title in percentile_header():
-        table.add_column(title)
-    for entry in entries:
-        table.add_row(escape(entry["figure"]), str(entry["cases"]), *(_number(entry[f"p{p}"]) for p in PERCENTILES))
-    return table
+def percentile_table(entries: list[dict]) -> WholeCellTable:
+    titles = percentile_header()
+    keys = [Column(titles[0], [entry["figure"] for entry in entries], "left")]
+    columns = [Column(titles[1], [str(entry["cases"]) for entry in entries])]
+    columns += [Column(title, [_number(entry[f"p{p}"]) for entry in entries]) for title, p in zip(titles[2:], PERCENTILES)]
+    return WholeCellTable(keys, columns)
 
 
 def opening_line(plan: SweepPlan, where: str) -> str:

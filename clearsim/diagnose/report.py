@@ -6,6 +6,7 @@ Nothing is overwritten silently: an earlier report's files are kept under number
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -15,8 +16,10 @@ from clearsim.diagnose.evaluate import document_text
 from clearsim.diagnose.search import JointFit, Scored, smoothed_interval
 from clearsim.diagnose.workflow import Diagnosis, Effect, effect_line, found_effect, refit_line
 from clearsim.io.hdf5 import keep_as_previous
+from clearsim.plot.style import LEGEND_WIDTH, legend_beside, new_figure, set_title, wrap_label
 
 REPORT, JSON = "report.md", "diagnosis.json"
+GAP_AXIS_CHARACTERS = 55  # characters of tick label that fit side by side under the gap axis
 
 
 def _effect(effect: Effect) -> dict:
@@ -148,13 +151,12 @@ def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
     for number, it in enumerate(d.iterations, start=1):
         out += [f"## Iteration {number}: candidates ranked", "",
                 "| candidate | parameter | best value | ΔBIC | gap | runs |", "|---|---|---|---|---|---|"]
-        for s in it.ranked:
+        for s, (name, _) in zip(it.ranked, ranked_rows(it.ranked)):
             best = s.estimate
             value = s.candidate.shown(best.value) if best else "—"
             delta = f"{s.delta_bic:.1f}" if np.isfinite(s.delta_bic) else "—"
             gap = f"{best.fit.gap:.3g}" if best else "run failed"
-            out.append(f"| {s.candidate.label}{'' if s.fitted else ' (screened)'} | {s.candidate.parameter} | "
-                       f"{value} | {delta} | {gap} | {len(s.points)} |")
+            out.append(f"| {name} | {s.candidate.parameter} | {value} | {delta} | {gap} | {len(s.points)} |")
         out.append("")
     out += ["## Figures", ""] + [f"![{p.stem}]({p.name})" for p in figures]
     out += ["", f"Augmented model: `{model_path.name}`.", ""]
@@ -169,54 +171,93 @@ def _joint_lines(d: Diagnosis) -> list[str]:
             "found each effect.", ""]
 
 
-def _figures(d: Diagnosis, fmt: str) -> list[Path]:
-    import matplotlib
+@dataclass
+class SensorComparison:
+    """One sensor of the comparison figure: the record and the model before and after, in the record's unit."""
+    sensor: str
+    unit: str
+    measured: np.ndarray
+    before: np.ndarray
+    after: np.ndarray
+    residual_before: np.ndarray  # / the noise level σ̂
+    residual_after: np.ndarray
+    gap_before: float
+    gap_after: float
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
-    paths = []
-    before = d.iterations[0].baseline_prediction
-    after = d.after_prediction
+def _comparisons(d: Diagnosis) -> list[SensorComparison]:
+    before, after = d.iterations[0].baseline_prediction, d.after_prediction
     aligned_before = predict(d.record, before.time, before.sensors, d.before.offset)
     aligned_after = predict(d.record, after.time, after.sensors, d.after.offset)
-    t = d.record.time * 1e3
-    fig, axes = plt.subplots(len(d.sensors), 2, figsize=(12, 3.2 * len(d.sensors)), squeeze=False)
     res_before, res_after = residuals(d.record, aligned_before), residuals(d.record, aligned_after)
-    for row, s in enumerate(d.sensors):
-        left, right = axes[row]
-        left.plot(t, d.record.values[s], color="0.6", lw=0.8, label="measured")
-        left.plot(t, aligned_before[s], lw=1.0, label="model as given")
-        left.plot(t, aligned_after[s], lw=1.0, ls="--", label="with the effects found")
-        left.set_ylabel(f"{s} [{d.units.get(s, '')}]")
-        right.plot(t, res_before[s] / d.record.noise[s].std, lw=0.8, label=f"before (gap {d.before.gaps[s]:.3g})")
-        right.plot(t, res_after[s] / d.record.noise[s].std, lw=0.8, label=f"after (gap {d.after.gaps[s]:.3g})")
-        right.axhspan(-3, 3, color="0.9")
+    return [SensorComparison(s, d.units.get(s, ""), d.record.values[s], aligned_before[s], aligned_after[s],
+                             res_before[s] / d.record.noise[s].std, res_after[s] / d.record.noise[s].std,
+                             d.before.gaps[s], d.after.gaps[s]) for s in d.sensors]
+
+
+def comparison_figure(time_ms: np.ndarray, comparisons: list[SensorComparison], title: str):
+    """Record and model before / after the effects found (left), residuals in noise levels (right)."""
+    figure = new_figure((10.0 + 2 * LEGEND_WIDTH, 3.2 * len(comparisons) + 0.9))
+    axes = figure.subplots(len(comparisons), 2, squeeze=False, sharex=True)
+    for (left, right), c in zip(axes, comparisons):
+        left.plot(time_ms, c.measured, color="0.6", lw=0.8, label="measured")
+        left.plot(time_ms, c.before, lw=1.0, label="model as given")
+        left.plot(time_ms, c.after, lw=1.0, ls="--", label="with the effects found")
+        left.set_ylabel(f"{c.sensor} ({c.unit})" if c.unit else c.sensor)
+        right.plot(time_ms, c.residual_before, lw=0.8, label=f"before (gap {c.gap_before:.3g})")
+        right.plot(time_ms, c.residual_after, lw=1.0, ls="--", label=f"after (gap {c.gap_after:.3g})")
+        right.axhspan(-3, 3, color="0.9", label="±3 noise levels")
         right.set_ylabel("residual / σ̂")
-        left.legend(fontsize=8), right.legend(fontsize=8)
+        legend_beside(left), legend_beside(right)
     for ax in axes[-1]:
-        ax.set_xlabel("time [ms]")
-    fig.tight_layout()
-    paths.append(_save(fig, d.folder / f"diagnose-comparison.{fmt}"))
-    fig, (rank_ax, gap_ax) = plt.subplots(1, 2, figsize=(12, 4))
-    ranked = [s for s in d.iterations[0].ranked if np.isfinite(s.delta_bic)][:12]
-    rank_ax.barh([s.candidate.label for s in ranked][::-1], [s.delta_bic for s in ranked][::-1])
+        ax.set_xlabel("time (ms)")
+    set_title(figure, title)
+    return figure
+
+
+def ranked_rows(ranked: list[Scored]) -> list[tuple[str, float]]:
+    """(candidate as report.md names it, ΔBIC or NaN) for every ranked candidate, in the report's order."""
+    return [(f"{s.candidate.label}{'' if s.fitted else ' (screened)'}", s.delta_bic) for s in ranked]
+
+
+def ranking_figure(rows: list[tuple[str, float]], gaps: list[tuple[str, float]], title: str):
+    """ΔBIC of every ranked candidate (a candidate whose runs failed: no bar, "—"), and the gap after each effect."""
+    figure = new_figure((12.0, max(4.0, 0.28 * len(rows) + 1.8)))
+    rank_ax, gap_ax = figure.subplots(1, 2, width_ratios=(1.6, 1.0))
+    names = [name for name, _ in rows][::-1]
+    values = np.array([value for _, value in rows][::-1], dtype=float)
+    shown = np.where(np.isfinite(values), values, 0.0)
+    rank_ax.barh(names, shown)
+    for position, value in enumerate(values):
+        if not np.isfinite(value):
+            rank_ax.annotate("— (runs failed)", (0.0, position), xytext=(4, 0), textcoords="offset points",
+                             va="center", fontsize=8)
     rank_ax.axvline(-10, color="k", ls=":", lw=0.8)
     rank_ax.set_xlabel("ΔBIC vs the model as given (below −10: significant)")
-    gaps = [d.before.gap] + [e.point.fit.gap for e in d.effects]
-    gap_ax.plot(range(len(gaps)), gaps, "o-")
-    gap_ax.set_xticks(range(len(gaps)), ["as given"] + [s.candidate.label for s in d.effects], rotation=15)
+    rank_ax.set_title("candidates ranked (iteration 1 of report.md)")
+    gap_ax.plot(range(len(gaps)), [gap for _, gap in gaps], "o-")
+    characters = max(8, GAP_AXIS_CHARACTERS // len(gaps) - 2)  # each label's lines fit its share of the axis
+    gap_ax.set_xticks(range(len(gaps)), [wrap_label(name, characters) for name, _ in gaps])
+    gap_ax.set_xlim(-0.5, len(gaps) - 0.5)
     gap_ax.set_ylabel("combined gap")
+    gap_ax.set_title("combined gap after each effect added")
     gap_ax.axhline(1.0, color="0.5", ls=":")
-    fig.tight_layout()
-    paths.append(_save(fig, d.folder / f"diagnose-ranking.{fmt}"))
-    return paths
+    set_title(figure, title)
+    return figure
+
+
+def _figures(d: Diagnosis, fmt: str) -> list[Path]:
+    name = f"{Path(d.request.config).name} against {Path(d.request.measured).name}"
+    comparison = comparison_figure(d.record.time * 1e3, _comparisons(d),
+                                   f"{name}\nrecord and model before and after the effects found; residuals in noise "
+                                   "levels σ̂")
+    gaps = [("as given", d.before.gap)] + [(e.candidate.label, e.point.fit.gap) for e in d.effects]
+    ranking = ranking_figure(ranked_rows(d.iterations[0].ranked), gaps, f"{name}\ncandidate effects and the gap")
+    return [_save(comparison, d.folder / f"diagnose-comparison.{fmt}"),
+            _save(ranking, d.folder / f"diagnose-ranking.{fmt}")]
 
 
 def _save(fig, path: Path) -> Path:
-    import matplotlib.pyplot as plt
-
     keep_as_previous(path)
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path

@@ -48,12 +48,32 @@ class PlotReport:
 
 @dataclass
 class _Inputs:
+    """Runs plotted together: one figure set named `<stem>-*`."""
     files: list
     stem: str
-    folder: Path | None  # a sweep folder
+    sweep: Path | None = None  # the sweep folder the runs are the cases of (its summary gives the merit figure)
+    folder: Path | None = None  # the folder they were found in: a file that cannot be plotted is skipped with a note
 
 
-def _inputs(paths: list) -> _Inputs:
+def _folder_inputs(folder: Path, notes: list) -> list[_Inputs]:
+    """The cases of the sweep that made the folder, overlaid; in any other folder each run on its own."""
+    files = sweep.result_files(folder)
+    cases = sweep.case_names(folder)
+    if cases is None:
+        notes.append(f"{folder} is not a sweep folder (no readable {sweep.CASES}): each run is plotted on its own; "
+                     f"to overlay runs, name their files: clearsim plot a.h5 b.h5")
+        return [_Inputs([file], file.stem, folder=folder) for file in files]
+    foreign = [file for file in files if file.stem not in cases]
+    for file in foreign:
+        notes.append(f"left out {file.name}: not a case of the sweep in {folder} (its {sweep.CASES} does not name "
+                     f"it); plot it on its own: clearsim plot {file}")
+    if len(foreign) == len(files):
+        raise PlotInputError(f"{folder}: none of its result files is a case of its sweep ({sweep.CASES}); plot them "
+                             f"by name: clearsim plot {files[0]}")
+    return [_Inputs([file for file in files if file not in foreign], "sweep", folder, folder)]
+
+
+def _inputs(paths: list, notes: list) -> list[_Inputs]:
     paths = [Path(p) for p in paths]
     if not paths:
         raise PlotInputError("give at least one result file (.h5) or a sweep folder")
@@ -61,13 +81,13 @@ def _inputs(paths: list) -> _Inputs:
     if folders and len(paths) > 1:
         raise PlotInputError(f"{folders[0]} is a folder: give either result files or one sweep folder")
     if folders:
-        return _Inputs(sweep.result_files(folders[0]), "sweep", folders[0])
-    return _Inputs(paths, paths[0].stem if len(paths) == 1 else "compare", None)
+        return _folder_inputs(folders[0], notes)
+    return [_Inputs(paths, paths[0].stem if len(paths) == 1 else "compare")]
 
 
 def _load(inputs: _Inputs, request: PlotRequest, notes: list) -> list[RunData]:
-    """The runs; in a sweep folder a case file that cannot be plotted is skipped with a note (the others are
-    plotted), while a file named on the command line must be plottable."""
+    """The runs; in a folder a file that cannot be plotted is skipped with a note (the others are plotted), while a
+    file named on the command line must be plottable."""
     window = parse_time_window(request.time_window)
     runs = []
     for path in inputs.files:
@@ -76,9 +96,8 @@ def _load(inputs: _Inputs, request: PlotRequest, notes: list) -> list[RunData]:
         except PlotInputError as exc:
             if inputs.folder is None:
                 raise
-            notes.append(f"skipped case {path.stem}: {exc} (a re-run of the sweep runs that case again)")
-    if not runs:
-        raise PlotInputError(f"{inputs.folder}: no case file can be plotted:\n  " + "\n  ".join(notes))
+            again = " (a re-run of the sweep runs that case again)" if inputs.sweep else ""
+            notes.append(f"skipped {'case' if inputs.sweep else 'file'} {path.stem}: {exc}{again}")
     labels = run_labels(runs) if len(runs) > 1 else [""] * len(runs)
     for index, (run, label) in enumerate(zip(runs, labels)):
         apply_window(run, window)
@@ -160,19 +179,24 @@ def plot_results(request: PlotRequest) -> PlotReport:
         raise PlotInputError(f"--format {request.fmt!r}: expected one of {', '.join(FORMATS)}")
     if request.out is not None and Path(request.out).exists() and not Path(request.out).is_dir():
         raise PlotInputError(f"--out {request.out}: is a file, not a folder; give the folder for the figures")
-    inputs = _inputs(request.inputs)
     skipped: list = []
-    runs = _load(inputs, request, skipped)
+    groups = _inputs(request.inputs, skipped)
+    loaded = [(inputs, runs) for inputs in groups if (runs := _load(inputs, request, skipped))]
+    if not loaded:
+        what = "case" if groups[0].sweep else "result"
+        raise PlotInputError(f"{groups[0].folder}: no {what} file can be plotted:\n  " + "\n  ".join(skipped))
     exaggerate = parse_exaggerate(request.exaggerate)
-    for run in runs if request.animate else []:
-        check_animation(run)
-    figures, notes = build_figures(runs, request, inputs.folder)
-    notes = skipped + notes
-    folder = _output_folder(request, inputs)
-    written = _save(figures, folder, inputs.stem, request.fmt)
-    if request.animate:
+    for _, runs in loaded if request.animate else []:
         for run in runs:
-            written.append(animate_run(run, folder / f"{run.path.stem}-animation.gif", exaggerate))
+            check_animation(run)
+    built = [(inputs, runs, *build_figures(runs, request, inputs.sweep)) for inputs, runs in loaded]
+    notes, written = list(skipped), []
+    for inputs, runs, figures, figure_notes in built:
+        notes += figure_notes
+        folder = _output_folder(request, inputs)
+        written += _save(figures, folder, inputs.stem, request.fmt)
+        if request.animate:
+            written += [animate_run(run, folder / f"{run.path.stem}-animation.gif", exaggerate) for run in runs]
     if request.show and (note := show_all()):
         notes.append(note)
     return PlotReport(written, notes)

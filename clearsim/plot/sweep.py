@@ -6,6 +6,7 @@ docs/sweeps.md §3) against the swept quantity.
 from __future__ import annotations
 
 import csv
+import json
 import math
 import re
 from dataclasses import dataclass
@@ -17,6 +18,7 @@ from clearsim.plot.data import PlotInputError
 from clearsim.plot.style import IDEAL_STYLE, RUN_COLOURS, axes_or_new, figure_legend, legend_beside, new_figure, set_title
 
 SUMMARY = "summary.csv"
+CASES = "cases.json"  # written by `clearsim sweep` into its folder: the cases it runs (docs/sweeps.md)
 BACKUP = re.compile(r"\.previous(-\d+)?\.h5$")  # a case's earlier result, kept by a re-run (docs/sweeps.md §4)
 BOOKKEEPING = {"case", "reference", "status", "error", "warnings", "reused", "steps", "rejected_steps", "wall_time_s"}
 MERITS = {  # column → (axis label, factor from the CSV's unit to the axis unit)
@@ -35,6 +37,15 @@ def result_files(folder: Path) -> list[Path]:
     if not files:
         raise PlotInputError(f"{folder} contains no result files (*.h5)")
     return files
+
+
+def case_names(folder: Path) -> set[str] | None:
+    """The names of the cases of the sweep that made `folder` (its cases.json); None when no sweep did (or its
+    cases.json cannot be read)."""
+    try:
+        return {str(case["name"]) for case in json.loads((folder / CASES).read_text(encoding="utf-8"))["cases"]}
+    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError):
+        return None
 
 
 @dataclass

@@ -1,5 +1,7 @@
 """Short real runs of the Flores slider-crank (3 ms: a few impacts) shared by the plotting tests."""
 
+import json
+import shutil
 from pathlib import Path
 
 import pytest
@@ -30,3 +32,13 @@ def runs(tmp_path_factory) -> dict:
         "tiny": _run(folder, "tiny", SLIDER_CRANK, "joints.slider_pin.clearance=0.05mm"),
         "friction": _run(folder, "friction", SLIDER_CRANK_FRICTION),
     }
+
+
+def sweep_folder(folder: Path, cases: dict) -> Path:
+    """A folder as `clearsim sweep` leaves it: {case name: result file} copied in, and its cases.json."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, path in cases.items():
+        if path is not None:
+            shutil.copy(path, folder / f"{name}.h5")
+    (folder / "cases.json").write_text(json.dumps({"cases": [{"name": name} for name in cases]}))
+    return folder

@@ -9,8 +9,9 @@ from typer.testing import CliRunner
 
 from clearsim.cli import app
 from clearsim.plot.animate import FRAMES
+from clearsim.plot.figures import _inputs
 
-from .conftest import SLIDER_CRANK
+from .conftest import SLIDER_CRANK, sweep_folder
 
 runner = CliRunner()
 
@@ -75,10 +76,7 @@ def test_vector_formats(runs, tmp_path, fmt, magic):
 
 
 def test_sweep_folder_overlays_every_case_and_plots_the_summary(runs, tmp_path):
-    folder = tmp_path / "sweep-sc"
-    folder.mkdir()
-    for name in ("ideal", "clearance", "small"):
-        shutil.copy(runs[name], folder / f"{name}.h5")
+    folder = sweep_folder(tmp_path / "sweep-sc", {name: runs[name] for name in ("ideal", "clearance", "small")})
     (folder / "summary.csv").write_text(
         "case,reference,clearance,status,peak_acceleration_m_s2,acceleration_ratio,start_delay_ms,end_error_percent,"
         "max_contact_force_N[slider_pin],steps\n"
@@ -94,8 +92,7 @@ def test_sweep_folder_overlays_every_case_and_plots_the_summary(runs, tmp_path):
 
 
 def test_sweep_folder_without_summary_has_no_merit_figure(runs, tmp_path):
-    for name in ("ideal", "clearance"):
-        shutil.copy(runs[name], tmp_path / f"{name}.h5")
+    sweep_folder(tmp_path, {name: runs[name] for name in ("ideal", "clearance")})
     result = invoke("plot", tmp_path, "--out", tmp_path / "figures")
     assert result.exit_code == 0, result.output
     assert not (tmp_path / "figures" / "sweep-merit.png").exists()
@@ -144,3 +141,27 @@ def test_help_of_both_commands():
     for command in ("plot", "draw"):
         result = invoke(command, "--help")
         assert result.exit_code == 0 and "Usage" in result.output
+
+
+def test_a_folder_that_no_sweep_made_plots_each_run_on_its_own(runs, tmp_path):
+    shutil.copy(runs["clearance"], tmp_path / "crank.h5")
+    shutil.copy(runs["friction"], tmp_path / "crank_with_friction.h5")  # another mechanism file, another day
+    result = invoke("plot", tmp_path)
+    assert result.exit_code == 0, result.output
+    names = {p.name for p in written(result)}
+    assert {"crank-output.png", "crank_with_friction-output.png"} <= names
+    assert not any(name.startswith("sweep-") for name in names)  # never overlaid as if one sweep
+    assert "is not a sweep folder (no readable cases.json): each run is plotted on its own" in " ".join(
+        result.output.split())
+
+
+def test_a_result_file_that_is_not_a_case_of_the_sweep_is_left_out_of_its_overlay(runs, tmp_path):
+    folder = sweep_folder(tmp_path / "sweep", {"ideal": runs["ideal"], "c05": runs["clearance"]})
+    shutil.copy(runs["friction"], folder / "stray.h5")
+    notes: list = []
+    (overlay,) = _inputs([folder], notes)
+    assert sorted(path.name for path in overlay.files) == ["c05.h5", "ideal.h5"]
+    assert any("left out stray.h5: not a case of the sweep" in note for note in notes)
+    result = invoke("plot", folder)
+    assert result.exit_code == 0 and "left out stray.h5" in " ".join(result.output.split()), result.output
+    assert not (folder / "stray-output.png").exists()

@@ -8,6 +8,8 @@ from typer.testing import CliRunner
 
 from clearsim.cli import app
 
+from .conftest import sweep_folder
+
 runner = CliRunner()
 
 
@@ -226,10 +228,8 @@ def test_an_incomplete_file_whose_datasets_end_apart_is_plotted_to_their_common_
 
 
 def test_a_sweep_folder_with_a_damaged_case_plots_the_others_and_names_it(runs, tmp_path):
-    folder = tmp_path / "sweep"
-    folder.mkdir()
-    shutil.copy(runs["ideal"], folder / "ideal.h5")
-    shutil.copy(runs["clearance"], folder / "slider_pin-0.5mm.h5")
+    folder = sweep_folder(tmp_path / "sweep", {"ideal": runs["ideal"], "slider_pin-0.5mm": runs["clearance"],
+                                               "slider_pin-0.25mm": None, "slider_pin-0.1mm": None})
     (folder / "slider_pin-0.25mm.h5").write_bytes(b"")
     (folder / "slider_pin-0.1mm.h5").write_bytes(runs["small"].read_bytes()[:5000])
     (folder / "summary.csv").write_bytes(b"\xff\xfe not text")
@@ -244,8 +244,7 @@ def test_a_sweep_folder_with_a_damaged_case_plots_the_others_and_names_it(runs, 
 
 
 def test_a_sweep_folder_whose_every_case_is_damaged(tmp_path):
-    folder = tmp_path / "sweep"
-    folder.mkdir()
+    folder = sweep_folder(tmp_path / "sweep", {"ideal": None})
     (folder / "ideal.h5").write_bytes(b"")
     message = fails(tmp_path, folder)
     assert f"{folder}: no case file can be plotted" in message and "ideal.h5 is not an HDF5 file" in message

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import List, Optional
 
 import typer
+import typer.core
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -23,8 +24,48 @@ from clearsim import __version__
 from clearsim.heartbeat import Heartbeat
 from clearsim.process import exit_without_final_collection
 
-app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
-                  help="Planar mechanisms with clearance joints: simulate, sweep, plot, diagnose.")
+BOOLEAN_WORDS = {"true", "false", "yes", "no", "on", "off", "1", "0", "y", "n"}
+
+
+class _Flags:
+    """Flags (`--show`, `--force`, `--help`) take no value. typer's rich help writes them as `--show <bool>`, and
+    `--show true` then reads `true` as the next argument (a file name): help writes them bare, and a true/false
+    word right after one is refused with exit code 2 (unless a file of that name exists)."""
+
+    def get_params(self, ctx):
+        params = super().get_params(ctx)
+        for param in params:
+            if getattr(param, "is_flag", False) and param.metavar is None:
+                param.metavar = ""  # no value column in the help
+        return params
+
+    def parse_args(self, ctx, args):
+        flags = {name: param for param in self.get_params(ctx) if getattr(param, "is_flag", False)
+                 for name in (*param.opts, *param.secondary_opts)}
+        for flag, value in zip(args, args[1:]):
+            if flag in flags and value.lower() in BOOLEAN_WORDS and not Path(value).exists():
+                off = flags[flag].secondary_opts
+                raise typer.BadParameter(f"{flag} is a switch and takes no value ('{flag} {value}'): write {flag} "
+                                         f"to turn it on, leave it out{f' (or {off[0]})' if off else ''} to leave it off",
+                                         ctx=ctx, param=flags[flag])
+        return super().parse_args(ctx, args)
+
+
+class _Command(_Flags, typer.core.TyperCommand):
+    pass
+
+
+class _Group(_Flags, typer.core.TyperGroup):
+    pass
+
+
+class _Typer(typer.Typer):
+    def command(self, *args, cls=_Command, **kwargs):
+        return super().command(*args, cls=cls, **kwargs)
+
+
+app = _Typer(cls=_Group, add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
+             help="Planar mechanisms with clearance joints: simulate, sweep, plot, diagnose.")
 console = Console(emoji=False)  # no emoji codes: "run.yaml:100:9" would print as "run.yaml💯9"
 errors = Console(stderr=True, emoji=False)
 _state = {"debug": False}

@@ -165,3 +165,21 @@ def test_a_result_file_that_is_not_a_case_of_the_sweep_is_left_out_of_its_overla
     result = invoke("plot", folder)
     assert result.exit_code == 0 and "left out stray.h5" in " ".join(result.output.split()), result.output
     assert not (folder / "stray-output.png").exists()
+
+
+def test_help_writes_flags_without_a_value():
+    for command in ([], ["plot"], ["draw"], ["sweep"], ["synthesize"]):
+        result = invoke(*command, "--help")
+        assert result.exit_code == 0, result.output
+        assert "<bool>" not in result.output and "--help" in result.output
+    assert "--show" in invoke("plot", "--help").output
+
+
+@pytest.mark.parametrize("command", ["plot", "draw"])
+def test_a_value_after_a_flag_is_refused_not_taken_for_a_file(runs, tmp_path, command):
+    source = runs["clearance"] if command == "plot" else SLIDER_CRANK
+    result = invoke(command, source, "--show", "true", "-o", tmp_path / "out")
+    assert result.exit_code == 2
+    output = " ".join(result.output.split())
+    assert "--show is a switch and takes no value" in output and "no such file" not in output
+    assert not (tmp_path / "out").exists()

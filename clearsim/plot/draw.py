@@ -16,7 +16,7 @@ from clearsim.io.files import same_file
 from clearsim.plot.drawing import draw_mechanism, drawing_size, label_items, legend_handles
 from clearsim.plot.geometry import Geometry, extent, mechanism_geometry, to_global
 from clearsim.plot.labelling import place_labels
-from clearsim.plot.style import DPI, FORMATS, new_figure, set_title, show_all
+from clearsim.plot.style import DPI, new_figure, set_title, show_all
 
 GROUP_DISTANCE = 0.15  # of the drawing's size: joints closer than this belong to one group
 DETAIL_SIZE = 0.4  # a group smaller than this fraction of the drawing gets a detail panel
@@ -116,37 +116,67 @@ def draw_figure(mechanism, body_names: list[str], q0: np.ndarray, subtitle: str 
     return figure
 
 
-def _check_figure_path(out: Path, config: Path, fmt: str) -> None:
+SAME_FORMAT = {"jpg": "jpeg", "tif": "tiff"}  # two names of one format
+
+
+def writable_formats() -> list[str]:
+    """The file formats matplotlib writes here (those of its Agg canvas: png, svg, pdf, jpg, …)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    return sorted(FigureCanvasAgg(Figure()).get_supported_filetypes())
+
+
+def _check_figure_path(out: Path, config: Path, formats: list[str]) -> None:
     """A drawing replaces an earlier figure, never a folder, the mechanism file or another file that is no figure."""
     from clearsim.plot.data import PlotInputError
 
-    hint = f"hint: give a figure file such as -o {out.with_suffix('.' + fmt).name if out.name else 'drawing.' + fmt}"
+    hint = f"hint: give a figure file such as -o {out.with_suffix('.png').name if out.name else 'drawing.png'}"
     if out.is_dir():
         raise PlotInputError(f"-o {out}: is a folder, not a figure file\n  hint: name the file in it, "
-                             f"e.g. -o {out / ('drawing.' + fmt)}")
+                             f"e.g. -o {out / 'drawing.png'}")
     if same_file(out, config):
         raise PlotInputError(f"-o {out}: that is the mechanism file being drawn; the figure would overwrite it\n  {hint}")
-    if out.exists() and out.suffix.lstrip(".").lower() not in FORMATS:
-        raise PlotInputError(f"-o {out}: an existing file that is not a figure ({', '.join(FORMATS)}); "
+    if out.exists() and out.suffix.lstrip(".").lower() not in formats:
+        raise PlotInputError(f"-o {out}: an existing file that is not a figure ({', '.join(formats)}); "
                              f"the drawing would overwrite it\n  {hint}")
+
+
+def figure_format(out: Path | None, fmt: str | None, formats: list[str]) -> str:
+    """The format to write: the one `-o` names by its extension (`--format`, if given, must agree), else `--format`,
+    else png. An extension matplotlib cannot write, or none, is refused: the file would hold another format."""
+    from clearsim.plot.data import PlotInputError
+
+    listing = ", ".join(formats)
+    if fmt is not None and fmt.lower() not in formats:
+        raise PlotInputError(f"--format {fmt!r}: matplotlib writes {listing}")
+    if out is None:
+        return (fmt or "png").lower()
+    suffix = out.suffix.lstrip(".").lower()
+    example = out.with_suffix("." + (fmt or "png").lower())
+    if suffix not in formats:
+        named = f"its extension .{suffix} is no figure format" if suffix else "it has no extension"
+        raise PlotInputError(f"-o {out}: {named}; name the format by the extension, one of {listing}\n"
+                             f"  hint: -o {example}")
+    if fmt is not None and SAME_FORMAT.get(fmt.lower(), fmt.lower()) != SAME_FORMAT.get(suffix, suffix):
+        raise PlotInputError(f"-o {out} names the format {suffix} but --format {fmt}: the file would hold {fmt} under "
+                             f"another name\n  hint: -o {example}, or leave out --format")
+    return suffix
 
 
 def draw_config(config: Path, overrides=(), out: Path | None = None, fmt: str | None = None,
                 interactive: bool = False) -> tuple[Path, list[str]]:
     """Load, assemble and draw a mechanism file; returns the written figure and notes for the user.
 
-    The format is `fmt`, else the suffix of `out` when it is one of FORMATS, else png.
+    The format is the one the extension of `out` names, else `fmt`, else png (`figure_format`).
     """
     from clearsim.model.loader import load_mechanism
-    from clearsim.plot.data import PlotInputError
     from clearsim.runner import prepare
 
-    suffix = Path(out).suffix.lstrip(".").lower() if out is not None else ""
-    fmt = fmt or (suffix if suffix in FORMATS else "png")
-    if fmt not in FORMATS:
-        raise PlotInputError(f"--format {fmt!r}: expected one of {', '.join(FORMATS)}")
+    formats = writable_formats()
     if out is not None:
-        _check_figure_path(Path(out), Path(config), fmt)
+        _check_figure_path(Path(out), Path(config), formats)
+    fmt = figure_format(Path(out) if out is not None else None, fmt, formats)
     loaded = load_mechanism(config, overrides)
     system = prepare(loaded)
     clearance = ", ".join(system.clearance_joints) or "none"

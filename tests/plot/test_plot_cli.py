@@ -183,3 +183,24 @@ def test_a_value_after_a_flag_is_refused_not_taken_for_a_file(runs, tmp_path, co
     output = " ".join(result.output.split())
     assert "--show is a switch and takes no value" in output and "no such file" not in output
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("name, fragment", [
+    ("fig.txt", "its extension .txt is no figure format; name the format by the extension, one of"),
+    ("fig", "it has no extension"),
+])
+def test_draw_refuses_an_extension_that_names_no_figure_format(tmp_path, name, fragment):
+    result = invoke("draw", SLIDER_CRANK, "-o", tmp_path / name)
+    assert result.exit_code == 2, result.output
+    output = " ".join(result.output.split())
+    assert fragment in output and "png" in output and "svg" in output and "hint: -o" in output
+    assert not (tmp_path / name).exists() and "Traceback" not in output
+
+
+def test_draw_writes_the_format_the_extension_names(tmp_path):
+    result = invoke("draw", SLIDER_CRANK, "-o", tmp_path / "fig.jpg")
+    assert result.exit_code == 0, result.output
+    assert_images([tmp_path / "fig.jpg"], "JPEG")
+    result = invoke("draw", SLIDER_CRANK, "-o", tmp_path / "fig.png", "--format", "svg")
+    assert result.exit_code == 2 and "names the format png but --format svg" in " ".join(result.output.split())
+    assert not (tmp_path / "fig.png").exists()

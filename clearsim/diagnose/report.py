@@ -13,7 +13,7 @@ import numpy as np
 
 from clearsim.diagnose.align import predict, residuals
 from clearsim.diagnose.evaluate import document_text
-from clearsim.diagnose.search import JointFit, Scored, smoothed_interval
+from clearsim.diagnose.search import SIGNIFICANCE, JointFit, Scored, smoothed_interval
 from clearsim.diagnose.workflow import Diagnosis, Effect, effect_line, found_effect, refit_line
 from clearsim.io.hdf5 import keep_as_previous
 from clearsim.plot.style import LEGEND_WIDTH, legend_beside, new_figure, set_title, wrap_label
@@ -232,8 +232,11 @@ def ranking_figure(rows: list[tuple[str, float]], gaps: list[tuple[str, float]],
         if not np.isfinite(value):
             rank_ax.annotate("— (runs failed)", (0.0, position), xytext=(4, 0), textcoords="offset points",
                              va="center", fontsize=8)
-    rank_ax.axvline(-10, color="k", ls=":", lw=0.8)
-    rank_ax.set_xlabel("ΔBIC vs the model as given (below −10: significant)")
+    rank_ax.axvline(-SIGNIFICANCE, color="k", ls=":", lw=0.8)
+    rank_ax.set_xscale("symlog", linthresh=SIGNIFICANCE)  # −230 and +9000 on one axis, the margin still readable
+    rank_ax.set_ylim(-0.6, len(names) - 0.4)
+    rank_ax.set_xlabel(f"ΔBIC vs the model as given (below −{SIGNIFICANCE:g}: significant; linear within ±{SIGNIFICANCE:g}, "
+                       "logarithmic beyond)")
     rank_ax.set_title("candidates ranked (iteration 1 of report.md)")
     gap_ax.plot(range(len(gaps)), [gap for _, gap in gaps], "o-")
     characters = max(8, GAP_AXIS_CHARACTERS // len(gaps) - 2)  # each label's lines fit its share of the axis

@@ -434,3 +434,14 @@ def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[s
     if problems:
         raise InputError(problems, name, source)
     return LoadedMechanism(mechanism, Path(name), source, document, base_dir or Path.cwd())
+
+
+def load_stored_mechanism(config_yaml: str, name: str) -> LoadedMechanism:
+    """The mechanism a result file stores (its `config_yaml`). A stored text without a `units:` block was written
+    when bare numbers meant SI (and one written now has none on a dimensional key), so it is read as `units: SI`."""
+    try:
+        document = yaml.load(config_yaml, Loader=FAST_LOADER)
+    except (yaml.YAMLError, RecursionError):
+        document = None  # the load below says what is wrong with it
+    declared = isinstance(document, dict) and "units" in document
+    return load_mechanism_text(config_yaml, name=name, overrides=() if declared else ("units=SI",))

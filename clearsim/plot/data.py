@@ -164,10 +164,10 @@ def _check_samples(path: Path, attrs: dict, data: dict) -> list[str]:
 
 def _mechanism(config_yaml: str, path: Path):
     """The stored mechanism, or None when this clearsim cannot load it (clearances then unknown)."""
-    from clearsim.model.loader import load_mechanism_text
+    from clearsim.model.loader import load_stored_mechanism
 
     try:
-        return load_mechanism_text(config_yaml, name=f"{path} (config_yaml)").mechanism
+        return load_stored_mechanism(config_yaml, name=f"{path} (config_yaml)").mechanism
     except ClearsimError:
         return None
 

@@ -277,3 +277,19 @@ def test_diagnose_writes_si_values_that_a_file_with_declared_units_reads_unchang
     assert abs(damper.at[0][0] - 1000.17) < 1e-9  # the far anchor: 1000 m along the output direction, in metres
     heavier = applied("mass", "crank", "mass factor", 1.5)
     assert heavier.bodies[0].mass == pytest.approx(0.45) and heavier.bodies[0].inertia == pytest.approx(1.5e-4)
+
+
+def test_a_stored_mechanism_without_units_is_read_as_si_and_one_with_units_as_declared():
+    """A result file's config_yaml written when bare numbers meant SI still loads (clearsim plot reads its clearances)."""
+    from clearsim.model.loader import load_stored_mechanism
+
+    old = flores(("bearing_radius: 10 mm", "bearing_radius: 0.01"), ("journal_radius: 9.5 mm", "journal_radius: 0.0095"))
+    assert "units" in load_error(old)
+    def clearance(text: str) -> float:
+        mechanism = load_stored_mechanism(text, "run.h5 (config_yaml)").mechanism
+        return resolve_clearance(mechanism.joint("slider_pin"), mechanism.defaults).clearance
+
+    assert clearance(old) == pytest.approx(0.5e-3, rel=1e-12)
+    millimetres = flores(("bearing_radius: 10 mm", "bearing_radius: 10"), ("journal_radius: 9.5 mm", "journal_radius: 9.5"),
+                         units="units: {length: mm}")
+    assert clearance(millimetres) == pytest.approx(0.5e-3, rel=1e-12)

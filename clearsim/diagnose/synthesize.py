@@ -145,11 +145,14 @@ def _run_model(request: SynthesisRequest, rate: float, loaded, sensors: list[str
     from clearsim.io.hdf5 import read_result
     from clearsim.model.loader import load_mechanism
     from clearsim.runner import prepare, run_to_file
+    from clearsim.solver.outputs import output_rate
 
-    if loaded.mechanism.solver.output_rate < rate:
+    system = prepare(loaded)
+    if output_rate(system) < rate:
         loaded = load_mechanism(request.config, [*request.overrides, f"solver.output_rate={rate!r} Hz"])
+        system = prepare(loaded)
     with tempfile.TemporaryDirectory(prefix="clearsim-synthesize-") as folder:
-        report = run_to_file(prepare(loaded), loaded, Path(folder) / "model.h5")
+        report = run_to_file(system, loaded, Path(folder) / "model.h5")
         if report.error is not None:
             raise report.error
         result = read_result(report.output)

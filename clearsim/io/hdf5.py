@@ -15,6 +15,7 @@ import shutil
 import signal
 import threading
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
@@ -98,14 +99,19 @@ _WITH_GROUPS.set_create_intermediate_group(True)
 _UNIT_TYPE = h5py.h5t.py_create(h5py.string_dtype("utf-8"), logical=True)  # as h5py stores a str attribute
 
 
+COMPRESSION_LEVEL = 1  # gzip (deflate) after the byte shuffle; docs/model.md §8 measures levels 1, 4, 9 and lzf
+
+
 def new_dataset(parent: h5py.h5g.GroupID, name: str, values: np.ndarray, unit: str, chunk_rows: int | None = None):
-    """What h5py's create_dataset(name, data=values[, chunks, maxshape=(None, …)]) and attrs["unit"] = unit write, by
-    its low-level API: 3 ms instead of 7.5 ms for the 41 datasets of a slider-crank run. With chunk_rows, chunked and
-    growing along the first axis."""
+    """What h5py's create_dataset(name, data=values[, chunks, maxshape=(None, …), shuffle=True,
+    compression="gzip"]) and attrs["unit"] = unit write, by its low-level API: 3 ms instead of 7.5 ms for the 41
+    datasets of a slider-crank run. With chunk_rows, chunked, compressed and growing along the first axis."""
     dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
     dcpl.set_obj_track_times(False)  # h5py's default: the same values give the same file
     if chunk_rows is not None:
         dcpl.set_chunk((chunk_rows, *values.shape[1:]))
+        dcpl.set_shuffle()
+        dcpl.set_deflate(COMPRESSION_LEVEL)
         space = h5py.h5s.create_simple(values.shape, (h5py.h5s.UNLIMITED, *values.shape[1:]))
     else:
         space = h5py.h5s.create_simple(values.shape)
@@ -200,7 +206,8 @@ class NotAResultFile(ValueError):
 
 
 def read_result(path: Path, wanted: Callable[[str], bool] | None = None) -> dict:
-    """All datasets (as arrays) and root attributes of a result file: {'attrs': {...}, 'time': …, 'bodies/x/q': …};
+    """All datasets (as arrays, floating-point ones as float64) and root attributes of a result file: {'attrs': {...},
+    'time': …, 'bodies/x/q': …};
     with `wanted`, only the datasets whose names it accepts (a summary need not hold a long run in memory)."""
     path = Path(path)
     try:
@@ -214,7 +221,8 @@ def read_result(path: Path, wanted: Callable[[str], bool] | None = None) -> dict
 
         def keep(name, node):
             if isinstance(node, h5py.Dataset):
-                out[name] = node[()]
+                values = node[()]  # a float32 history is handed on as float64, as older files stored it
+                out[name] = values.astype(np.float64) if values.dtype == np.float32 else values
 
         if wanted is None:
             handle.visititems(keep)
@@ -233,3 +241,29 @@ def group_attribute(path: Path, group: str, name: str, default=None):
     with h5py.File(path, "r") as handle:
         node = handle.get(group)
         return node.attrs.get(name, default) if node is not None else default
+
+
+@dataclass
+class ResultOverview:
+    """What a result file holds, read without its histories: size on disk, samples, rate, what it describes."""
+
+    size_bytes: int
+    samples: int
+    rate_hz: float | None  # None: fewer than two samples and no `output_rate_hz` attribute (an older file)
+    rate_derived: bool  # the rate came from the model's time scales, not from solver.output_rate
+    members: dict[str, int]  # group → how many bodies, joints, sensors, … it holds
+
+
+def result_overview(path: Path) -> ResultOverview:
+    """The ResultOverview of a result file (older files without the `output_rate_hz` attribute: the rate from the
+    spacing of their first two samples)."""
+    path = Path(path)
+    with h5py.File(path, "r") as handle:
+        time = handle.get("time")
+        samples = 0 if time is None else time.shape[0]
+        rate = handle.attrs.get("output_rate_hz")
+        if rate is None and samples >= 2:
+            rate = 1.0 / float(time[1] - time[0])
+        members = {group: len(handle[group]) for group in ("bodies", "joints", "sensors") if group in handle}
+        derived = handle.attrs.get("output_rate_source") == "derived"
+    return ResultOverview(path.stat().st_size, samples, None if rate is None else float(rate), derived, members)

@@ -5,9 +5,15 @@ continuous contact. A contact episode runs from onset (δ rising through 0) to l
 *impact* when it ends within IMPACT_DURATION_FACTOR × the Hertz contact time of an impact at
 its own δ̇⁻ and effective mass (t_H = 2.943 δ_max/δ̇⁻, δ_max = (5 m_eff δ̇⁻²/(4K))^(2/5)),
 and *continuous contact* otherwise (including an episode still open at the end of the run).
+
+The output rate, when the file does not set `solver.output_rate`, comes from the model's time scales
+(`derived_output_rate`), and each dataset is stored in float64 or float32 by what its users need
+(`stored_values`); docs/model.md §8 argues both.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -15,13 +21,91 @@ from clearsim.assembly.arrays import CL_EXPONENT, CL_MIN_IMPACT_SPEED, CL_STIFFN
 from clearsim.assembly.forces import STICK
 from clearsim.assembly.dynamics import WORK_APPLIED, WORK_CONTACT, WORK_DAMPING, WORK_DRIVER, WORK_FRICTION
 from clearsim.assembly.system import SensorSpec, System
+from clearsim.model import schema
+from clearsim.units import UnitError, to_si
 from clearsim.solver.samples import C_ECC_X, C_ECC_Y, C_FRICTION, C_NORMAL, C_PENETRATION, C_RATE, C_SLIDING
 
 FREE_FLIGHT, IMPACT, CONTINUOUS_CONTACT = 0, 1, 2
 IMPACT_DURATION_FACTOR = 3.0
 HERTZ_DURATION = 2.943  # t_c = 2.943 δ_max / v (docs/model-contact.md)
 
+# the default output rate (docs/model.md §8): enough samples per the shortest time scale of the model, within bounds
+SAMPLES_PER_CONTACT = 20  # per Hertz contact duration t_c: a sampled half-sine peak is within 1 - cos(π/20) = 1.2 %
+SAMPLES_PER_DRIVE = 1000  # per stroke time, or per revolution of a constant-speed rotary drive
+REFERENCE_IMPACT_SPEED = 1.0  # m/s: the impact speed of the t_c estimate (t_c ∝ v^(-1/5): 0.1 m/s → 1.58 × longer)
+LOWEST_DEFAULT_RATE, HIGHEST_DEFAULT_RATE = 1e3, 1e5  # Hz
+
+# datasets a user needs to full precision (docs/model.md §8); every other floating-point history is stored as float32
+FULL_PRECISION_SUFFIXES = ("/q", "/eccentricity", "/penetration")
+
 COORDINATE_UNITS = {"q": "m, m, rad", "qd": "m/s, m/s, rad/s", "qdd": "m/s^2, m/s^2, rad/s^2"}
+
+
+def hertz_contact_duration(effective_mass: float, stiffness: float, exponent: float, speed: float) -> float:
+    """Duration of an undamped impact m δ̈ = −K δ^n at speed v: t_c = 2 (δ_max/v) ∫₀¹ dx/√(1 − x^(n+1)), the integral
+    B(1/(n+1), 1/2)/(n+1), δ_max = ((n+1) m v²/(2K))^(1/(n+1)); 2.943 δ_max/v for n = 1.5 (docs/model-contact.md)."""
+    a = 1.0 / (exponent + 1.0)
+    integral = a * math.gamma(a) * math.gamma(0.5) / math.gamma(a + 0.5)
+    depth = ((exponent + 1.0) * effective_mass * speed**2 / (2.0 * stiffness)) ** a
+    return 2.0 * integral * depth / speed
+
+
+def contact_durations(system: System) -> list[float]:
+    """t_c of each clearance joint at REFERENCE_IMPACT_SPEED, with the reduced mass of its two bodies as m_eff (the
+    lightest a linkage can put behind the contact, so the shortest t_c; the ground counts as infinitely heavy)."""
+    arrays = system.arrays
+    durations = []
+    for (bearing, journal), params in zip(arrays.clearance_bodies, arrays.clearance_params):
+        masses = [arrays.mass[b] for b in (bearing, journal) if b >= 0]
+        reduced_mass = 1.0 / sum(1.0 / m for m in masses)
+        durations.append(hertz_contact_duration(reduced_mass, params[CL_STIFFNESS], params[CL_EXPONENT],
+                                                REFERENCE_IMPACT_SPEED))
+    return durations
+
+
+def drive_time_scales(mechanism: schema.Mechanism) -> list[float]:
+    """The stroke time of each stroke drive and the revolution 2π/|ω| of each constant-speed rotary drive (other
+    laws, and constant-speed linear drives, have no time scale of their own)."""
+    revolute = {joint.name for joint in mechanism.joints if isinstance(joint, schema.RevoluteJoint)}
+    scales = []
+    for driver in mechanism.drivers:
+        law = driver.motion
+        if isinstance(law, schema.StrokeMotion):
+            scales.append(law.duration)
+        elif isinstance(law, schema.ConstantSpeedMotion) and (driver.joint in revolute or driver.coordinate == "angle"):
+            try:
+                speed = abs(to_si(law.speed, "angular_speed"))
+            except UnitError:
+                continue
+            if speed > 0.0:
+                scales.append(2.0 * math.pi / speed)
+    return scales
+
+
+def derived_output_rate(system: System) -> float:
+    """The default output rate (Hz): SAMPLES_PER_CONTACT per the shortest contact duration and SAMPLES_PER_DRIVE per
+    the shortest drive time scale, whichever needs more, within LOWEST_DEFAULT_RATE … HIGHEST_DEFAULT_RATE."""
+    needed = [SAMPLES_PER_CONTACT / t for t in contact_durations(system)]
+    needed += [SAMPLES_PER_DRIVE / t for t in drive_time_scales(system.mechanism)]
+    return float(np.clip(max(needed, default=LOWEST_DEFAULT_RATE), LOWEST_DEFAULT_RATE, HIGHEST_DEFAULT_RATE))
+
+
+def output_rate(system: System) -> float:
+    """Samples per second written: the file's `solver.output_rate`, or derived_output_rate when it sets none."""
+    explicit = system.mechanism.solver.output_rate
+    return float(explicit) if explicit is not None else derived_output_rate(system)
+
+
+def full_precision(name: str) -> bool:
+    """Whether a dataset is stored in float64 (docs/model.md §8)."""
+    return name == "time" or name.startswith("sensors/") or name.endswith(FULL_PRECISION_SUFFIXES)
+
+
+def stored_values(name: str, values: np.ndarray) -> np.ndarray:
+    """The values as the result file stores them: float32 unless `full_precision(name)`; integers as they are."""
+    if values.dtype == np.float64 and not full_precision(name):
+        return values.astype(np.float32)
+    return values
 
 
 def _rotate(angle, vectors):
@@ -191,3 +275,8 @@ def chunk_outputs(system: System, chunk, modes: np.ndarray, initial_energy: floa
     for spec in system.sensors:
         out[f"sensors/{spec.name}"] = sensor_value(system, spec, chunk, joints, origins.get(spec.name))
     return out
+
+
+def stored_outputs(outputs: dict) -> dict:
+    """chunk_outputs' datasets in the precision the file stores each in (stored_values)."""
+    return {name: (stored_values(name, values), unit) for name, (values, unit) in outputs.items()}

@@ -23,7 +23,7 @@ from clearsim.errors import SolverError
 from clearsim.model.schema import SolverSettings
 from clearsim.solver import integrator as ig
 from clearsim.solver import precompile
-from clearsim.solver.outputs import hertz_durations
+from clearsim.solver.outputs import hertz_durations, output_rate
 from clearsim.solver.samples import CONTACT_FIELDS, ENERGY_FIELDS, E_KINETIC, E_POTENTIAL, E_VIOLATION
 
 SAMPLE_BUFFER = 2048
@@ -217,7 +217,7 @@ class Run:
         self.peak_force = np.zeros(nc)
         self.real = np.zeros(ig.REAL_SLOTS)
         self.ints = np.zeros(ig.INT_SLOTS, np.int64)
-        dt = 1.0 / settings.output_rate
+        dt = 1.0 / output_rate(system)
         self.real[[ig.R_T_END, ig.R_RTOL, ig.R_ATOL, ig.R_MAX_STEP, ig.R_MIN_STEP, ig.R_SAMPLE_DT]] = (
             settings.t_end, settings.rtol, settings.atol, settings.max_step, settings.min_step, dt)
         self.ints[ig.I_TOTAL_SAMPLES] = int(np.floor(settings.t_end / dt + 1e-9)) + 1

@@ -193,7 +193,7 @@ def result_file_bytes(system: System, contents: str = "all") -> float:
         "time": 1,
         "bodies/b/q": 3 * bodies, "bodies/b/qd": 6 * bodies,
         "joints/j/reaction": 2 * (len(system.pin_joints) + len(system.prismatic_joints)),
-        "joints/j/eccentricity": 3 * clearances, "joints/j/normal_force": 5 * clearances,
+        "joints/j/eccentricity": 5 * clearances, "joints/j/sliding_velocity": 3 * clearances,
         "drivers/d/effort": len(system.drivers),
         "sensors/s": len(system.sensors),
         "energy/e": 9,

@@ -347,7 +347,7 @@ class OutputSensors(Strict):
 
 class SolverSettings(Strict):
     t_end: Time = Field(gt=0.0, description="end time of the simulation")
-    output_rate: Frequency | None = Field(None, gt=0.0, description="samples per second of the written histories; default: from the model's time scales, 20 per contact duration and 1000 per drive stroke or revolution, within 1 kHz to 100 kHz (docs/model.md §8)")
+    output_rate: Frequency | None = Field(None, gt=0.0, description="samples per second of the written histories; default: from the model's time scales, 1 kHz to 100 kHz (docs/model.md §8)")
     rtol: float = Field(1e-7, gt=0.0, lt=1.0, description="relative error tolerance per step")
     atol: float = Field(1e-10, gt=0.0, description="absolute tolerance on positions (m, rad) and velocities")
     max_step: Time = Field(1e-3, gt=0.0, description="largest step")

@@ -36,7 +36,8 @@ REFERENCE_IMPACT_SPEED = 1.0  # m/s: the impact speed of the t_c estimate (t_c �
 LOWEST_DEFAULT_RATE, HIGHEST_DEFAULT_RATE = 1e3, 1e5  # Hz
 
 # datasets a user needs to full precision (docs/model.md §8); every other floating-point history is stored as float32
-FULL_PRECISION_SUFFIXES = ("/q", "/eccentricity", "/penetration")
+FULL_PRECISION_SUFFIXES = ("/q", "/eccentricity", "/penetration", "/normal_force", "/friction_force")
+FULL_PRECISION_GROUPS = ("sensors/", "energy/")
 
 COORDINATE_UNITS = {"q": "m, m, rad", "qd": "m/s, m/s, rad/s", "qdd": "m/s^2, m/s^2, rad/s^2"}
 
@@ -98,7 +99,7 @@ def output_rate(system: System) -> float:
 
 def full_precision(name: str) -> bool:
     """Whether a dataset is stored in float64 (docs/model.md §8)."""
-    return name == "time" or name.startswith("sensors/") or name.endswith(FULL_PRECISION_SUFFIXES)
+    return name == "time" or name.startswith(FULL_PRECISION_GROUPS) or name.endswith(FULL_PRECISION_SUFFIXES)
 
 
 def stored_values(name: str, values: np.ndarray) -> np.ndarray:

@@ -22,7 +22,8 @@ JOINT = "slider_pin"
 
 def dataset(path: Path, key: str) -> np.ndarray:
     with h5py.File(path, "r") as handle:
-        return handle[key][()]
+        values = handle[key][()]
+        return values.astype(float) if values.dtype == np.float32 else values  # as read_result hands it on
 
 
 def axes():

@@ -259,7 +259,7 @@ def sweep(
     retry_failed: bool = typer.Option(False, "--retry-failed", help="Run cases that failed before again."),
     keep: str = typer.Option(
         "all", "--keep", help="What each case's file holds: all, or summary (the sensors, the clearance joints, the "
-        "energies: what the summary and `clearsim plot` read; a UHV case ~4× smaller, for Monte Carlo studies)."),
+        "energies: what the summary and `clearsim plot` read; a UHV case ~3× smaller, for Monte Carlo studies)."),
 ) -> None:
     """Run a parameter study: one run per case, in parallel, with a summary table and summary.csv."""
     from clearsim.runner import BUNDLED_CONFIG

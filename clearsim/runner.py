@@ -33,7 +33,7 @@ BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
 # which per-sample histories a result file holds (its `contents` attribute, absent for "all"), each a subset of the
 # one before: every dataset of DESIGN.md §6; "summary", all but the bodies' q, q̇, q̈ and the ideal joints' reactions
 # — what a sweep's summary table and `clearsim plot`'s figures read (`clearsim sweep --keep summary`; a UHV case at
-# 100 kHz 13.4 → 3.1 MB); or the sensors alone — a diagnosis reads nothing else of its model runs (0.63 MB). The
+# 100 kHz 4.4 → 1.3 MB); or the sensors alone — a diagnosis reads nothing else of its model runs (0.31 MB). The
 # contact modes' episode tables and the run's attributes are in every file.
 CONTENTS = {"all": lambda name: True,
             "summary": lambda name: not name.startswith("bodies/") and not name.endswith("/reaction"),

@@ -149,7 +149,7 @@ class ResultWriter:
     def _append(self, name: str, values: np.ndarray, unit: str) -> None:
         values = np.ascontiguousarray(values)
         if name not in self.created:  # a set, not `name in self.file`: the lookup by path costs as much as the write
-            chunk_rows = max(1, min(4096, 2**20 // max(1, values[0].nbytes if values.ndim > 1 else 8)))
+            chunk_rows = max(1, min(1024, 2**20 // max(1, values[0].nbytes if values.ndim > 1 else 8)))
             new_dataset(self.file.id, name, values, unit, chunk_rows)
             self.created.add(name)
             return

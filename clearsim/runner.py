@@ -104,7 +104,8 @@ def _final_attributes(run: Run) -> dict:
             "kernels_compiled": stats.kernels_compiled, "steps": stats.steps, "rejected_steps": stats.rejected_steps,
             "rhs_evaluations": stats.rhs_evaluations, "contact_events": stats.contact_events,
             "max_step_violation": stats.max_violation, "simulated_time_s": run.time,
-            "tolerance_over_penetration": stats.tolerance_over_penetration, "warnings": "\n".join(run.warnings())}
+            "tolerance_over_penetration": stats.tolerance_over_penetration,
+            "peak_output_acceleration": stats.peak_output_acceleration, "warnings": "\n".join(run.warnings())}
 
 
 def _write_episodes(writer: ResultWriter, system: System, run: Run, sample_episodes: np.ndarray) -> None:
@@ -276,6 +277,10 @@ def summarize(path: Path, data: dict | None = None) -> Summary:
         name = output.get(role)
         values = _finite(data.get(f"sensors/{name}", NO_SAMPLES)) if name else NO_SAMPLES
         peak[role] = (name, float(np.max(np.abs(values)))) if len(values) else None
+    if peak["acceleration"] is not None:  # the larger of the sampled peak and the one at every step's end
+        name, sampled = peak["acceleration"]
+        tracked = float(data["attrs"].get("peak_output_acceleration", 0.0))
+        peak["acceleration"] = (name, max(sampled, tracked if np.isfinite(tracked) else 0.0))
     joints = [j for j in str(data["attrs"].get("clearance_joints", "")).split(",") if j]
     forces = {j: _peak_contact_force(path, j, data.get(f"joints/{j}/normal_force", NO_SAMPLES)) for j in joints}
     shares = {}
@@ -309,7 +314,9 @@ def _output_sensors(config_yaml: str) -> dict:
 
 
 def _frequency(hertz: float) -> str:
-    return f"{hertz / 1e3:.4g} kHz" if hertz >= 1e3 else f"{hertz:.4g} Hz"
+    scale, unit = next((scale, unit) for scale, unit in ((1e6, "MHz"), (1e3, "kHz"), (1.0, "Hz")) if hertz >= scale
+                       or unit == "Hz")
+    return f"{hertz / scale:.4g} {unit}"
 
 
 def written_line(path: Path) -> str:

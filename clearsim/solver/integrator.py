@@ -52,7 +52,10 @@ from clearsim.solver.samples import derive_sample
 # real_state slots
 (R_TIME, R_STEP, R_T_END, R_RTOL, R_ATOL, R_MAX_STEP, R_MIN_STEP, R_SAMPLE_DT, R_VIOLATION, R_COARSE_TIME,
  R_COARSE_RATIO) = range(11)
-REAL_SLOTS = 11
+# the output acceleration sensor (body index, −1 for none; its point in the body frame; its direction) and its peak
+R_OUTPUT_BODY, R_OUTPUT_POINT_X, R_OUTPUT_POINT_Y, R_OUTPUT_DIRECTION_X, R_OUTPUT_DIRECTION_Y, R_PEAK_ACCELERATION = (
+    range(11, 17))
+REAL_SLOTS = 17
 # int_state slots
 (I_STATUS, I_STEPS, I_REJECTED, I_RHS, I_EVENTS, I_SAMPLES, I_NEXT_SAMPLE, I_FAIL_JOINT, I_LOG, I_TOTAL_SAMPLES,
  I_FRICTION_EVENTS, I_STALLED, I_COARSE, I_COARSE_JOINT) = range(14)
@@ -427,6 +430,23 @@ def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
 
 
 @njit(cache=True, inline="always")
+def update_output_peak(n, y, f, real):
+    """Raise real[R_PEAK_ACCELERATION] to |a · d| of the output point at a step's end, q and q̇ from y, q̈ from f = ẏ
+    (the steps resolve each impact, so the peak does not depend on the output rate)."""
+    b = int(real[R_OUTPUT_BODY])
+    if b < 0:
+        return
+    c, s = np.cos(y[3 * b + 2]), np.sin(y[3 * b + 2])
+    arm_x = c * real[R_OUTPUT_POINT_X] - s * real[R_OUTPUT_POINT_Y]
+    arm_y = s * real[R_OUTPUT_POINT_X] + c * real[R_OUTPUT_POINT_Y]
+    omega, alpha = y[n + 3 * b + 2], f[n + 3 * b + 2]
+    ax = f[n + 3 * b] - alpha * arm_y - omega**2 * arm_x
+    ay = f[n + 3 * b + 1] + alpha * arm_x - omega**2 * arm_y
+    real[R_PEAK_ACCELERATION] = max(real[R_PEAK_ACCELERATION],
+                                    abs(ax * real[R_OUTPUT_DIRECTION_X] + ay * real[R_OUTPUT_DIRECTION_Y]))
+
+
+@njit(cache=True, inline="always")
 def refine_event(system, dynamics, projection, k, kind, t, y, f, h_event, modes, speeds, stages, y_event, ints):
     """Integrate from t exactly to joint k's event; returns the step length.
 
@@ -546,6 +566,7 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
                 return
         rhs(system, dynamics, real[R_TIME], y, modes, speeds, f)
         ints[I_RHS] += 1
+        update_output_peak(n, y, f, real)
 
 
 # the kernels `advance` takes by address, in its argument order (addressed_kernels)

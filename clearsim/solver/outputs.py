@@ -97,6 +97,16 @@ def output_rate(system: System) -> float:
     return float(explicit) if explicit is not None else derived_output_rate(system)
 
 
+def output_acceleration_point(system: System) -> tuple[float, float, float, float, float]:
+    """(body index, point x, y in the body frame, direction x, y) of the `output.acceleration` sensor, whose peak the
+    integrator tracks at every step; body −1 when the mechanism names none."""
+    spec = next((spec for spec in system.sensors
+                 if spec.name == system.output.acceleration and spec.kind == "point_acceleration"), None)
+    if spec is None:
+        return (-1.0, 0.0, 0.0, 0.0, 0.0)
+    return (float(spec.body), *map(float, spec.point), *map(float, spec.direction))
+
+
 def full_precision(name: str) -> bool:
     """Whether a dataset is stored in float64 (docs/model.md §8)."""
     return name == "time" or name.startswith(FULL_PRECISION_GROUPS) or name.endswith(FULL_PRECISION_SUFFIXES)

@@ -23,7 +23,7 @@ from clearsim.errors import SolverError
 from clearsim.model.schema import SolverSettings
 from clearsim.solver import integrator as ig
 from clearsim.solver import precompile
-from clearsim.solver.outputs import hertz_durations, output_rate
+from clearsim.solver.outputs import hertz_durations, output_acceleration_point, output_rate
 from clearsim.solver.samples import CONTACT_FIELDS, ENERGY_FIELDS, E_KINETIC, E_POTENTIAL, E_VIOLATION
 
 SAMPLE_BUFFER = 2048
@@ -75,6 +75,7 @@ class Statistics:
     kernel_time: float = 0.0  # s of the loop's first call in this run: loading it, or on an empty cache compiling it
     kernels_compiled: bool = False  # the kernel cache held no compiled loop when the run started
     peak_normal_force: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    peak_output_acceleration: float = 0.0  # |output.acceleration| at every step's end (0: no such sensor)
     tolerance_over_penetration: float = 0.0  # largest over the contact onsets (docs/model.md §4)
 
 
@@ -221,6 +222,8 @@ class Run:
         self.real[[ig.R_T_END, ig.R_RTOL, ig.R_ATOL, ig.R_MAX_STEP, ig.R_MIN_STEP, ig.R_SAMPLE_DT]] = (
             settings.t_end, settings.rtol, settings.atol, settings.max_step, settings.min_step, dt)
         self.ints[ig.I_TOTAL_SAMPLES] = int(np.floor(settings.t_end / dt + 1e-9)) + 1
+        self.real[[ig.R_OUTPUT_BODY, ig.R_OUTPUT_POINT_X, ig.R_OUTPUT_POINT_Y, ig.R_OUTPUT_DIRECTION_X,
+                   ig.R_OUTPUT_DIRECTION_Y]] = output_acceleration_point(system)
         self.buffers = (np.zeros(SAMPLE_BUFFER), np.zeros((SAMPLE_BUFFER, self.y.size)),
                         np.zeros((SAMPLE_BUFFER, nc), np.int64), np.zeros((SAMPLE_BUFFER, nc)),
                         np.zeros((SAMPLE_BUFFER, nc), np.int64), np.zeros((SAMPLE_BUFFER, n)),
@@ -248,6 +251,7 @@ class Run:
             max_violation=float(self.real[ig.R_VIOLATION]), wall_time=self.wall_time, kernel_time=self.kernel_time,
             kernels_compiled=self.kernels_compiled,
             peak_normal_force=self.peak_force.copy(), tolerance_over_penetration=float(self.real[ig.R_COARSE_RATIO]),
+            peak_output_acceleration=float(self.real[ig.R_PEAK_ACCELERATION]),
         )
 
     def warnings(self) -> list[str]:

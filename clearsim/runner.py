@@ -314,9 +314,10 @@ def _output_sensors(config_yaml: str) -> dict:
 
 
 def _frequency(hertz: float) -> str:
-    scale, unit = next((scale, unit) for scale, unit in ((1e6, "MHz"), (1e3, "kHz"), (1.0, "Hz")) if hertz >= scale
-                       or unit == "Hz")
-    return f"{hertz / scale:.4g} {unit}"
+    for scale, unit in ((1e6, "MHz"), (1e3, "kHz")):
+        if hertz >= scale:
+            return f"{hertz / scale:.4g} {unit}"
+    return f"{hertz:.4g} Hz"
 
 
 def written_line(path: Path) -> str:

@@ -30,7 +30,7 @@ IMPACT_DURATION_FACTOR = 3.0
 HERTZ_DURATION = 2.943  # t_c = 2.943 δ_max / v (docs/model-contact.md)
 
 # the default output rate (docs/model.md §8): enough samples per the shortest time scale of the model, within bounds
-SAMPLES_PER_CONTACT = 20  # per Hertz contact duration t_c: a sampled half-sine peak is within 1 - cos(π/20) = 1.2 %
+SAMPLES_PER_CONTACT = 20  # per Hertz contact duration t_c: the shape of an impact; a half sine's peak within 1.2 %
 SAMPLES_PER_DRIVE = 1000  # per stroke time, or per revolution of a constant-speed rotary drive
 REFERENCE_IMPACT_SPEED = 1.0  # m/s: the impact speed of the t_c estimate (t_c ∝ v^(-1/5): 0.1 m/s → 1.58 × longer)
 LOWEST_DEFAULT_RATE, HIGHEST_DEFAULT_RATE = 1e3, 1e5  # Hz
@@ -52,8 +52,8 @@ def hertz_contact_duration(effective_mass: float, stiffness: float, exponent: fl
 
 
 def contact_durations(system: System) -> list[float]:
-    """t_c of each clearance joint at REFERENCE_IMPACT_SPEED, with the reduced mass of its two bodies as m_eff (the
-    lightest a linkage can put behind the contact, so the shortest t_c; the ground counts as infinitely heavy)."""
+    """t_c of each clearance joint at REFERENCE_IMPACT_SPEED, with the reduced mass m₁m₂/(m₁ + m₂) of its two bodies
+    as m_eff (the ground counts as infinitely heavy): an estimate from the masses alone, before the mechanism moves."""
     arrays = system.arrays
     durations = []
     for (bearing, journal), params in zip(arrays.clearance_bodies, arrays.clearance_params):

@@ -42,26 +42,14 @@ FULL_PRECISION_GROUPS = ("sensors/", "energy/")
 COORDINATE_UNITS = {"q": "m, m, rad", "qd": "m/s, m/s, rad/s", "qdd": "m/s^2, m/s^2, rad/s^2"}
 
 
-def hertz_contact_duration(effective_mass: float, stiffness: float, exponent: float, speed: float) -> float:
-    """Duration of an undamped impact m δ̈ = −K δ^n at speed v: t_c = 2 (δ_max/v) ∫₀¹ dx/√(1 − x^(n+1)), the integral
-    B(1/(n+1), 1/2)/(n+1), δ_max = ((n+1) m v²/(2K))^(1/(n+1)); 2.943 δ_max/v for n = 1.5 (docs/model-contact.md)."""
-    a = 1.0 / (exponent + 1.0)
-    integral = a * math.gamma(a) * math.gamma(0.5) / math.gamma(a + 0.5)
-    depth = ((exponent + 1.0) * effective_mass * speed**2 / (2.0 * stiffness)) ** a
-    return 2.0 * integral * depth / speed
-
-
-def contact_durations(system: System) -> list[float]:
-    """t_c of each clearance joint at REFERENCE_IMPACT_SPEED, with the reduced mass m₁m₂/(m₁ + m₂) of its two bodies
-    as m_eff (the ground counts as infinitely heavy): an estimate from the masses alone, before the mechanism moves."""
+def contact_durations(system: System) -> np.ndarray:
+    """t_H (hertz_durations) of each clearance joint at REFERENCE_IMPACT_SPEED, with the reduced mass m₁m₂/(m₁ + m₂)
+    of its two bodies as m_eff (the ground counts as infinitely heavy): an estimate before the mechanism moves."""
     arrays = system.arrays
-    durations = []
-    for (bearing, journal), params in zip(arrays.clearance_bodies, arrays.clearance_params):
-        masses = [arrays.mass[b] for b in (bearing, journal) if b >= 0]
-        reduced_mass = 1.0 / sum(1.0 / m for m in masses)
-        durations.append(hertz_contact_duration(reduced_mass, params[CL_STIFFNESS], params[CL_EXPONENT],
-                                                REFERENCE_IMPACT_SPEED))
-    return durations
+    joints = np.arange(arrays.clearance_bodies.shape[0])
+    masses = np.where(arrays.clearance_bodies >= 0, arrays.mass[np.maximum(arrays.clearance_bodies, 0)], np.inf)
+    reduced = 1.0 / np.sum(1.0 / masses, axis=1)
+    return hertz_durations(system, joints, np.full(len(joints), REFERENCE_IMPACT_SPEED), reduced)
 
 
 def drive_time_scales(mechanism: schema.Mechanism) -> list[float]:

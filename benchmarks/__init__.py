@@ -1,1 +1,1 @@
-"""clearsim benchmarks (issue #6): `python -m benchmarks --help`. Not part of the tests."""
+"""clearsim benchmarks: `python -m benchmarks --help`. Not part of the tests."""

@@ -1,4 +1,4 @@
-"""The benchmark cases of issue #6, timed after a warm-up, each with its accuracy against a run at
+"""The benchmark cases, timed after a warm-up, each with its accuracy against a run at
 100× tighter tolerance; a table on the terminal and a JSON file to compare runs.
 
     python -m benchmarks                       # every case, 5 repeats → benchmarks/results/latest.json
@@ -414,7 +414,7 @@ PROFILED = ("uhv-ideal", "uhv-c0.01", "uhv-c0.1")
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m benchmarks", description="clearsim benchmarks (issue #6)")
+    parser = argparse.ArgumentParser(prog="python -m benchmarks", description="clearsim benchmarks")
     parser.add_argument("--quick", action="store_true", help="1 repeat, shortened cases, short sweep and studies")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--cases", help="comma-separated names (default: all): " + ", ".join(c.name for c in CASES)

@@ -7,7 +7,7 @@ scope with every variable of the function again: O(blocks × variables) per inli
 #9204; numba 0.68). With one memo for the blocks of one `inline_ir` call the copy is the deep copy of the whole IR,
 with the aliasing the interpreter built (one scope, shared variables) instead of a scope per block, and costs
 O(blocks + variables): `advance`'s 54 inlined copies took 1.8–2.0 s of a cold compile, now 0.5–0.6 s
-(docs/performance.md, *Session 14*). Applied once per process, before any kernel compiles, where numba's inliner is
+(docs/performance.md, *Compile time*). Applied once per process, before any kernel compiles, where numba's inliner is
 built as this expects (its module's `copy` and `InlineWorker.inline_ir`); elsewhere numba's own copy runs unchanged.
 """
 

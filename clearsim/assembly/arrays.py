@@ -70,7 +70,7 @@ SystemArrays = namedtuple(
 # A kernel called with the namedtuple receives 23 arrays (≈ 200 machine words) and takes and releases a
 # reference to each at every call; with the structref it receives one pointer. Same fields, same attribute
 # syntax in the kernels, results bitwise identical; the compiled loop takes 40–50 % less time and compiles
-# faster (docs/performance.md, session 5).
+# faster (docs/performance.md).
 
 
 @structref.register

@@ -127,7 +127,7 @@ def jacobian_blocks(system, q):
 def dense_jacobian(system, q: np.ndarray) -> np.ndarray:
     """Φ_q as a dense (m, 3 nb) matrix, scattered with numpy from the blocks the solver works on (the assembly's
     Newton steps and checks, tests). Not a kernel: the blocks' kernel is compiled for the loop anyway, and a kernel
-    of its own cost a first run ~1.5 s of compiling before the loop's (docs/performance.md, Session 14)."""
+    of its own cost a first run ~1.5 s of compiling before the loop's (docs/performance.md, Compile time)."""
     blocks, bodies = jacobian_blocks(system, q)
     jac = np.zeros((blocks.shape[0], q.shape[0]))
     rows, slots = np.nonzero(bodies >= 0)  # the ground (−1) has no columns

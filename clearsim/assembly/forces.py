@@ -1,6 +1,6 @@
 """Generalised forces Q(t, q, q̇): gravity, point loads, spring-dampers and clearance contacts (compiled).
 
-Clearance joint k (Meng 2015 §2, restated in DESIGN.md §4): bearing centre P_B on the first body,
+Clearance joint k (Meng 2015 §2, restated in docs/model.md §3): bearing centre P_B on the first body,
 journal centre P_J on the second; eccentricity e = P_J − P_B, n = e/|e|, penetration δ = |e| − c,
 penetration rate δ̇ = ė·n, tangent t = (−n_y, n_x) and sliding velocity
 v_t = ė·t + ω_J R_J − ω_B R_B (material points of journal and bearing at the contact).

@@ -1,6 +1,6 @@
 """assemble(mechanism) → System: arrays for the kernels, names for the outputs, a consistent initial state.
 
-Initial assembly (DESIGN.md §3): Newton iteration on Φ(q, 0) = 0 from the YAML's poses with
+Initial assembly (docs/model.md §1): Newton iteration on Φ(q, 0) = 0 from the YAML's poses with
 clearance joints temporarily pinned at their initial eccentricity (centred by default), then
 the velocities nearest (in the kinetic-energy metric) to the YAML's that satisfy Φ_q q̇ = ν,
 again with the journals moving with their bearings.

@@ -1,4 +1,4 @@
-"""Diagnosis groundwork (issue #5): measured data in, measured-like data out.
+"""Diagnosis groundwork: measured data in, measured-like data out.
 
     data = read_measured("bench.csv", model_sensor_units(mechanism), mapping={"Weg": "sealing_rod_displacement"})
     report = synthesize(SynthesisRequest(config, overrides, sensors=["slider_displacement"], ...))

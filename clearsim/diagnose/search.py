@@ -471,7 +471,7 @@ def mark_ties(ranked: list[Scored], all_sensors_scale: dict[str, float]) -> None
 
 def halves_improved(record: Record, baseline: Point, effect: Point) -> tuple[float, float]:
     """Δχ² of the effect over the model on each half of the record (both negative: the improvement
-    is not carried by one part of the record alone — the split-record check of DESIGN.md §8)."""
+    is not carried by one part of the record alone — the split-record check of docs/diagnose.md)."""
     def halves(point: Point):
         return chi_square_halves(record, aligned_residuals(record, point.prediction, point.fit.offset))
 

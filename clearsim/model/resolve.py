@@ -244,7 +244,7 @@ def _stiffness(contact: dict, origin: dict, bearing: float, journal: float, mate
 
 
 def auto_stiffness(bearing: float, journal: float, material) -> float:
-    """K of a journal in a bearing of the same material (clearsim.physics.contact, DESIGN.md §4)."""
+    """K of a journal in a bearing of the same material (clearsim.physics.contact, docs/model-contact.md)."""
     from clearsim.physics.contact import internal_contact_stiffness
 
     modulus, poisson = material.youngs_modulus, material.poisson_ratio

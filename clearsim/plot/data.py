@@ -83,7 +83,7 @@ class RunData:
         return [key.split("/", 1)[1] for key in self.datasets if key.startswith("sensors/")]
 
 
-# what a file with fewer histories than DESIGN.md §6 holds (its `contents` attribute, runner.CONTENTS)
+# what a file with fewer histories than the full layout holds (its `contents` attribute, runner.CONTENTS)
 REDUCED_CONTENTS = {
     "summary": "the histories a sweep keeps with --keep summary (no bodies' motion, no ideal joints' reactions)",
     "sensors": "the time and the sensors alone (a diagnosis's model run)",

@@ -6,7 +6,7 @@ falling through −ε, a hysteresis of ε = 1e-12 m so that a restart at δ ≈ 
 re-fires nor misses the event) are found on the step's continuous extension, including a
 graze that enters and leaves inside one step (an extremum of δ, located where δ̇ = 0). The
 step that holds the earliest event is then integrated again exactly up to the event, with
-Newton corrections of its length until |δ| < 1e-3 ε (DESIGN.md §4 "restart state"). At onset
+Newton corrections of its length until |δ| < 1e-3 ε (docs/model.md §4). At onset
 the impact speed δ̇⁻ is stored for the damping law and the next step starts from the Hertz
 contact time t_c = 3.218 (m_eff/K)^(2/5) δ̇⁻^(−1/5) / 20. Free flight steps never exceed the
 time to cross the clearance c at the current relative speed. Output samples come from the

@@ -1,4 +1,4 @@
-"""Named time histories from sampled chunks: the HDF5 layout of DESIGN.md §6 as a dict path → (array, unit).
+"""Named time histories from sampled chunks: the HDF5 layout of README and docs/reference.md as a dict path → (array, unit).
 
 Contact modes (written per sample, int8): 0 free flight (no contact episode), 1 impact, 2
 continuous contact. A contact episode runs from onset (δ rising through 0) to loss; it is an

@@ -108,7 +108,7 @@ def chunk_span(finest: float, last_span: float, simulated: float, wall: float) -
     at least `finest` (1 % of t_end) and at most GROWTH × the last span (the pace drops when impacts begin).
 
     Returning every 1 % cost ~25 µs a return (the call's 25 arguments, the samples' copies), 2.5 ms of a 30 ms
-    run (docs/performance.md, session 11)."""
+    run (docs/performance.md)."""
     if simulated <= 0.0 or wall <= 0.0:
         return finest
     return max(finest, min(GROWTH * last_span, simulated / wall * PROGRESS_SECONDS))

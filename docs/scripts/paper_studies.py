@@ -62,7 +62,7 @@ SWEPT = {"friction": "defaults.friction.mu_d", "friction_rtol": "defaults.fricti
          "uhv_rtol": "solver.rtol", "uhv_rate": "solver.output_rate", "uhv_rate_c01": "solver.output_rate"}
 DEFAULT_RTOL, TIGHT_RTOL = "1e-7", "1e-9"
 
-PAPER = {  # Meng et al. 2015, section 4 (quoted in DESIGN.md §5 / issue 7); missing: not given in the text
+PAPER = {  # Meng et al. 2015, section 4 (quoted in docs/reference.md); missing: not given in the text
     "j_only": {"0.01": {"acceleration_ratio": 3.58}},
     "a_and_j": {"0.01": {"peak_acceleration_m_s2": 2325.6, "start_delay_ms": 1.6},
                 "0.1": {"peak_acceleration_m_s2": 10345.5, "start_delay_ms": 4.2, "end_error_percent": 8.5}},
@@ -275,7 +275,7 @@ def detailed_row(name, row):
 
 
 def print_paper_vs_clearsim(studies):
-    """The compact table of issue 7: the paper's numbers beside clearsim's, over the run and over 0–10 ms."""
+    """The compact table: the paper's numbers beside clearsim's, over the run and over 0–10 ms."""
     j_only, a_and_j, friction = studies["j_only"], studies["a_and_j"], studies["friction"]
     ideal = result(ideal_row(a_and_j))
     print("\n| quantity | case | paper | clearsim, whole stroke | clearsim, first 10 ms |")

@@ -1,4 +1,4 @@
-"""Print every number of docs/validation.md (cases 1–5 of issue 7) as Markdown tables.
+"""Print every number of docs/validation.md (cases 1–5) as Markdown tables.
 
 Run from the repository root:
 

@@ -1,4 +1,4 @@
-"""A hidden friction change is named as friction at the right joint and μ_d is fitted within 20 % (issue #5).
+"""A hidden friction change is named as friction at the right joint and μ_d is fitted within 20 %.
 
 Friction reaches the slider's displacement and velocity through the chaotic journal motion in the clearance
 joint, so χ² over μ_d is a comb of narrow minima (teeth ~0.004 wide) over a smooth basin: the lowest run of a

@@ -2,8 +2,7 @@
 (docs/performance.md, *Compile time*).
 
 numba types a constant argument (`True`, `-1`, `NORMAL`) as a literal and compiles the callee, with its whole
-subtree, once for each literal it sees; session 4 removed 23 such double compilations, and session 6 found one it had
-brought back itself (a `with_sticks` flag, ~1 s of compile time). On an empty kernel cache, the helper
+subtree, once for each literal it sees (a `with_sticks` flag passed as a literal once cost ~1 s of compile time). On an empty kernel cache, the helper
 (`python -m clearsim.solver.precompile`) compiles its kernels (`kernels_ahead`) first, as it does beside a first run;
 a run in a fresh process then compiles the rest and is checked for kernels compiled twice, for kernels the helper
 wrote that it compiled itself (the helper's signatures no longer match the run's), and for results that differ from a

@@ -1,5 +1,5 @@
 """The loop calls its larger kernels by address (clearsim/solver/integrator.py `addressed_kernels`, `compiled_loop`,
-docs/performance.md *Compile time*, session 12): `advance` has one specialisation, whose arguments for the mode
+docs/performance.md *Compile time*): `advance` has one specialisation, whose arguments for the mode
 switch, the projection and the dynamics are function types, not the dispatchers' own types (which would link those
 kernels into it and into every kernel it passes them to), and it compiles nothing else, so arguments of another type
 fail at once."""

@@ -20,7 +20,7 @@ def defaults(**fields) -> Defaults:
 
 
 def hand_stiffness(bearing, journal, modulus=STEEL_E, poisson=STEEL_NU):
-    """K = 4/(3(σ_B + σ_J)) sqrt(R_B R_J/(R_B − R_J)), σ = (1 − ν²)/E, same material (DESIGN.md §4)."""
+    """K = 4/(3(σ_B + σ_J)) sqrt(R_B R_J/(R_B − R_J)), σ = (1 − ν²)/E, same material (docs/model-contact.md)."""
     sigma = (1.0 - poisson**2) / modulus
     return 4.0 / (3.0 * 2.0 * sigma) * math.sqrt(bearing * journal / (bearing - journal))
 

@@ -1,4 +1,4 @@
-"""The result file: DESIGN.md §6 layout, units, round trip of the config, flagged partial results, backups."""
+"""The result file: its layout (README), units, round trip of the config, flagged partial results, backups."""
 
 import h5py
 import numpy as np

@@ -1,9 +1,9 @@
 """A run says when its tolerance cannot resolve a contact (docs/model.md §4, "Unresolved contacts").
 
-Session 5 found that at rtol 1e-4, atol 1e-7 m the frictionless slider-crank sinks a gentle contact 0.33 mm into
+At rtol 1e-4, atol 1e-7 m the frictionless slider-crank sinks a gentle contact 0.33 mm into
 the bearing (392 kN instead of 46 kN) and finishes without a word; the run now finishes with a warning naming the
 joint, and stays silent at the default tolerances, where the same contacts are resolved. That gentle contact comes
-late in a chaotic impact sequence, so whether a run meets it depends on round-off (on session 8's machine the same
+late in a chaotic impact sequence, so whether a run meets it depends on round-off (on another machine the same
 run does not): the test takes the first impact, the same on every machine, at a position tolerance of 1 mm (13× its
 Hertz penetration).
 """

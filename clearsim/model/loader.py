@@ -466,6 +466,25 @@ def boolean_problems(value: Any, path: tuple = ()) -> list[Problem]:
     return []
 
 
+MAX_OUTPUT_SAMPLES = 1e9  # of each history: 8 GB a value written per sample; a long run writes a few million
+HIGHEST_OUTPUT_RATE = 1e5  # Hz
+
+
+def duration_problems(mechanism: Mechanism) -> list[Problem]:
+    """A t_end (× output_rate) no run could finish or write: refused here, where its line is known, before the run
+    asks the disk for "about inf MB"."""
+    solver = mechanism.solver
+    rate = getattr(solver, "output_rate", None) or HIGHEST_OUTPUT_RATE  # none written: chosen by the run, at most that
+    samples = solver.t_end * rate
+    if samples <= MAX_OUTPUT_SAMPLES:
+        return []
+    return [Problem(("solver", "t_end"), f"t_end = {solver.t_end:.3g} s at output_rate {rate:.3g} Hz is "
+                    f"{samples:.3g} samples of each history, more than a result file can hold "
+                    f"({MAX_OUTPUT_SAMPLES:.0e})", "t_end is the simulated time: a stroke or a few cycles of a "
+                    "mechanism last milliseconds to seconds (the bundled models: 24 ms and 85 ms), e.g. t_end: 100 ms; "
+                    "or lower solver.output_rate")]
+
+
 def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[str] = (),
                         base_dir: Path | None = None) -> LoadedMechanism:
     """As load_mechanism, from YAML text (`name` is used in messages)."""
@@ -477,7 +496,7 @@ def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[s
     mechanism = None
     try:
         mechanism = validate_mechanism(document)
-        problems += check_references(mechanism)
+        problems += check_references(mechanism) + duration_problems(mechanism)
     except ValidationError as exc:
         problems += validation_problems(exc, document, Mechanism) + _references_of_valid_part(document, exc)
     if problems:

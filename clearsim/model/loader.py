@@ -474,7 +474,7 @@ def duration_problems(mechanism: Mechanism) -> list[Problem]:
     """A t_end (× output_rate) no run could finish or write: refused here, where its line is known, before the run
     asks the disk for "about inf MB"."""
     solver = mechanism.solver
-    rate = getattr(solver, "output_rate", None) or HIGHEST_OUTPUT_RATE  # none written: chosen by the run, at most that
+    rate = solver.output_rate or HIGHEST_OUTPUT_RATE  # none written: chosen by the run, at most that
     samples = solver.t_end * rate
     if samples <= MAX_OUTPUT_SAMPLES:
         return []

@@ -17,7 +17,7 @@ from typing import Iterable, Sequence
 Path_ = tuple[str | int, ...]
 
 MAX_PROBLEMS_SHOWN = 20  # the first ones in file order; the others usually repeat them (an alias, a copied block)
-MAX_LINE = 300  # characters of a line of a message, with every value quoted in it
+MAX_LINE = 1000  # characters of a line of a message, with every value quoted in it (a long path or hint fits)
 MAX_LINES = 100  # lines of any message
 
 

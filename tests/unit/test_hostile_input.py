@@ -13,7 +13,7 @@ from yaml.scanner import ScannerError
 
 from clearsim.cli import app
 from clearsim.diagnose import MeasuredDataError, read_measured
-from clearsim.errors import InputError
+from clearsim.errors import MAX_LINE, InputError, bounded
 from clearsim.model import loader
 from tests.unit.test_loader import SLIDER_CRANK, edited, line_of, load_error
 
@@ -109,7 +109,7 @@ def test_a_set_value_that_cannot_be_read_is_reported_at_the_set(override, fragme
     clearance silently unset, exit 0."""
     message = load_error(SLIDER_CRANK, override)
     assert message.startswith("in --set " + override[:40]), message
-    assert fragment in message and len(message.splitlines()[0]) <= 300
+    assert fragment in message and len(message.splitlines()[0]) <= MAX_LINE
 
 
 def test_an_empty_set_value_exits_2_and_leaves_the_earlier_result_in_place(tmp_path):
@@ -180,7 +180,14 @@ def test_thousands_of_problems_make_a_short_message():
     message = load_error(text)
     assert sum(line.startswith("sc.yaml:") for line in message.splitlines()) == 20
     assert message.endswith("... and 181 more problems: fix the first 20 and check again")
-    assert max(len(line) for line in message.splitlines()) <= 300 and len(message) < 20_000
+    assert max(len(line) for line in message.splitlines()) <= MAX_LINE and len(message) < 20_000
+
+
+def test_every_error_message_is_bounded_in_lines_and_line_length():
+    message = bounded("\n".join(["x" * 5000] * 300))
+    lines = message.splitlines()
+    assert len(lines) == 101 and lines[-1] == "... (200 more lines)"
+    assert lines[0] == "x" * (MAX_LINE - 3) + "..."
 
 
 # --- files that are not files -----------------------------------------------------------------------

@@ -13,7 +13,8 @@ from yaml.scanner import ScannerError
 
 from clearsim.cli import app
 from clearsim.diagnose import MeasuredDataError, read_measured
-from clearsim.errors import MAX_LINE, InputError, bounded
+from clearsim import errors
+from clearsim.errors import InputError
 from clearsim.model import loader
 from tests.unit.test_loader import SLIDER_CRANK, edited, line_of, load_error
 
@@ -109,7 +110,7 @@ def test_a_set_value_that_cannot_be_read_is_reported_at_the_set(override, fragme
     clearance silently unset, exit 0."""
     message = load_error(SLIDER_CRANK, override)
     assert message.startswith("in --set " + override[:40]), message
-    assert fragment in message and len(message.splitlines()[0]) <= MAX_LINE
+    assert fragment in message and len(message.splitlines()[0]) <= errors.MAX_LINE
 
 
 def test_an_empty_set_value_exits_2_and_leaves_the_earlier_result_in_place(tmp_path):
@@ -180,14 +181,14 @@ def test_thousands_of_problems_make_a_short_message():
     message = load_error(text)
     assert sum(line.startswith("sc.yaml:") for line in message.splitlines()) == 20
     assert message.endswith("... and 181 more problems: fix the first 20 and check again")
-    assert max(len(line) for line in message.splitlines()) <= MAX_LINE and len(message) < 20_000
+    assert max(len(line) for line in message.splitlines()) <= errors.MAX_LINE and len(message) < 20_000
 
 
 def test_every_error_message_is_bounded_in_lines_and_line_length():
-    message = bounded("\n".join(["x" * 5000] * 300))
+    message = errors.bounded("\n".join(["x" * 5000] * 300))
     lines = message.splitlines()
     assert len(lines) == 101 and lines[-1] == "... (200 more lines)"
-    assert lines[0] == "x" * (MAX_LINE - 3) + "..."
+    assert lines[0] == "x" * (errors.MAX_LINE - 3) + "..."
 
 
 # --- files that are not files -----------------------------------------------------------------------
@@ -223,6 +224,18 @@ def test_a_named_pipe_is_refused_not_waited_on(tmp_path, command):
     with named_pipe(tmp_path / "sc.yaml") as fifo:
         result = invoke(command, fifo, *output)
     assert_located_exit_2(result, f"{fifo}\n  cannot read the file: it is a named pipe (FIFO), not a regular file")
+
+
+def test_a_force_table_that_is_a_named_pipe_is_refused_at_its_file_key(tmp_path):
+    """A FIFO named by a tabulated force's `file:` blocked `clearsim validate` for ever."""
+    config = tmp_path / "sc.yaml"
+    text = FLORES.read_text() + ("forces:\n  - {type: tabulated, name: push, body: slider, direction: [1, 0], "
+                                 "file: push.csv, time_unit: ms, value_unit: N}\n")
+    config.write_text(text)
+    with named_pipe(tmp_path / "push.csv"):
+        result = invoke("validate", config)
+    assert_located_exit_2(result, f"sc.yaml:{line_of(text, 'file: push.csv')}:", "forces[0] 'push' → file",
+                          "push.csv' is not a regular file (a folder, a named pipe or a device)")
 
 
 def test_a_regular_file_beyond_32_mb_is_still_refused_by_its_size(tmp_path):

@@ -105,7 +105,7 @@ def user_errors(command):
 
     @functools.wraps(command)
     def wrapper(*args, **kwargs):
-        from clearsim.errors import ClearsimError
+        from clearsim.errors import ClearsimError, bounded
 
         signal.signal(signal.SIGTERM, _terminate)
         try:
@@ -113,7 +113,7 @@ def user_errors(command):
         except ClearsimError as exc:
             if _state["debug"]:
                 raise
-            errors.print(f"[bold red]error:[/] {escape(str(exc))}", markup=True, highlight=False, soft_wrap=True)
+            errors.print(f"[bold red]error:[/] {escape(bounded(str(exc)))}", markup=True, highlight=False, soft_wrap=True)
             raise typer.Exit(INPUT_ERROR) from None
         except OSError as exc:  # an output folder that cannot be made, a file that cannot be written or read
             if _state["debug"]:

@@ -16,6 +16,24 @@ from typing import Iterable, Sequence
 
 Path_ = tuple[str | int, ...]
 
+MAX_PROBLEMS_SHOWN = 20  # the first ones in file order; the others usually repeat them (an alias, a copied block)
+MAX_LINE = 1000  # characters of a line of a message, with every value quoted in it (a long path or hint fits)
+MAX_LINES = 100  # lines of any message
+
+
+def clipped(text: str, limit: int = MAX_LINE) -> str:
+    """`text`, cut to `limit` characters ("..." at the end when cut)."""
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def bounded(message: str) -> str:
+    """A message of at most MAX_LINES lines of at most MAX_LINE characters: a value of megabytes quoted in it, or
+    thousands of problems, cannot flood the terminal."""
+    lines = [clipped(line) for line in message.splitlines()]
+    if len(lines) > MAX_LINES:
+        lines = lines[:MAX_LINES] + [f"... ({len(lines) - MAX_LINES} more lines)"]
+    return "\n".join(lines)
+
 
 class ClearsimError(Exception):
     """Base of every error that is reported to the user as one message."""
@@ -69,7 +87,11 @@ class InputError(ClearsimError):
         super().__init__(self.report())
 
     def report(self) -> str:
-        blocks = [self._block(problem) for problem in sorted(self.problems, key=self._order)]
+        ordered = sorted(self.problems, key=self._order)
+        blocks = [self._block(problem) for problem in ordered[:MAX_PROBLEMS_SHOWN]]
+        if len(ordered) > MAX_PROBLEMS_SHOWN:
+            blocks.append(f"... and {len(ordered) - MAX_PROBLEMS_SHOWN} more problems: fix the first "
+                          f"{MAX_PROBLEMS_SHOWN} and check again")
         return "\n".join(blocks)
 
     def __str__(self) -> str:
@@ -104,7 +126,7 @@ class InputError(ClearsimError):
         where = format_path(problem.path, self._names()) if problem.path else ""
         override = self._override_of(problem)
         if override is not None:
-            return f"in --set {override}" + (f"  {where}" if where else "")
+            return f"in --set {clipped(override, MAX_LINE // 2)}" + (f"  {where}" if where else "")
         if problem.position is not None:
             line, column = problem.position
             return f"{file}:{line}:{column}" + (f"  {where}" if where else "")
@@ -115,9 +137,9 @@ class InputError(ClearsimError):
         return f"{file}:{position[0]}:{position[1]}  {format_path(problem.path, self._names())}{note}"
 
     def _block(self, problem: Problem) -> str:
-        lines = [self._header(problem), f"  {problem.message}"]
+        lines = [clipped(self._header(problem)), clipped(f"  {problem.message}")]
         if problem.hint:
-            lines.append(f"  hint: {problem.hint}")
+            lines.append(clipped(f"  hint: {problem.hint}"))
         return "\n".join(lines)
 
 

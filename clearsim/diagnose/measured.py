@@ -30,6 +30,7 @@ MIN_SAMPLES = 20
 TIME = "time"
 HEADER = re.compile(r"^\s*(?P<name>[^\[\(]+?)\s*(?:[\[\(](?P<unit>[^\]\)]*)[\]\)])?\s*$")
 DELIMITERS = (",", ";", "\t")
+MAX_MAGNITUDE = 1e100  # SI: far beyond any bench, far below where squares and sums of squares overflow (1e154)
 GAP_FACTOR = 10.0  # a time step this many times the record's median step is a gap (or a change of time unit)
 
 # SI unit of each sensor type (as written in /sensors/<name>.attrs["unit"]) and the unit's kind
@@ -93,6 +94,9 @@ def read_measured(path: Path | str, sensor_units: Mapping[str, str] | None = Non
         raise MeasuredDataError(f"{path}: no such file; check the path of the measured data")
     if path.is_dir():
         raise MeasuredDataError(f"{path} is a folder; give the measured record itself (a CSV or HDF5 file)")
+    if not path.is_file():  # a named pipe would block the read for ever, a device never end it
+        raise MeasuredDataError(f"{path}: not a regular file (a named pipe or a device); give the measured record "
+                                "itself (a CSV or HDF5 file)")
     if path.suffix.lower() in (".h5", ".hdf5", ".hdf"):
         raw = _hdf5_columns(path)
     else:
@@ -269,6 +273,8 @@ def _assemble(path: Path, raw: _Raw, sensor_units: dict | None, mapping: dict, u
     values = {t: _converted(path, raw, c, known[t], units) for c, t in chosen.items()}
     for column in [time_column, *chosen]:
         _check_finite(path, raw, column, column == time_column)
+    for column, converted in [(time_column, time), *((c, values[t]) for c, t in chosen.items())]:
+        _check_magnitude(raw, column, converted)
     for column in chosen:
         _check_alive(path, raw, column, units)
     _check_time(path, raw, time, time_column, min_samples, units)
@@ -322,7 +328,8 @@ def _converted(path: Path, raw: _Raw, column: str, si_unit: str, units: dict) ->
     if len(values) != len(raw.row_names):
         raise MeasuredDataError(f"{path}: column '{column}' has {len(values)} samples, the time has "
                                 f"{len(raw.row_names)}; every sensor needs one value per time")
-    return values * factor
+    with np.errstate(over="ignore"):  # a sample its unit turns into inf is reported by _check_magnitude
+        return values * factor
 
 
 def _factor(path: Path, column: str, unit: str, si_unit: str) -> float:
@@ -361,6 +368,17 @@ def _check_finite(path: Path, raw: _Raw, column: str, is_time: bool = False) -> 
     if bad.size:
         raise MeasuredDataError(f"{raw.row_names[bad[0]]}: column '{column}' is not a finite number ({bad.size} "
                                 "such value(s)); remove those rows or fill the gap before using the record")
+
+
+def _check_magnitude(raw: _Raw, column: str, si_values: np.ndarray) -> None:
+    """A sample beyond MAX_MAGNITUDE in SI (or one its unit turned into inf) is no measurement: squared in the noise
+    estimate or the fit, it overflows."""
+    bad = np.flatnonzero(~(np.abs(si_values) <= MAX_MAGNITUDE))
+    if bad.size:
+        written = raw.array(column)[bad[0]]
+        raise MeasuredDataError(f"{raw.row_names[bad[0]]}: column '{column}': {written:g} is beyond any measured value "
+                                f"(more than {MAX_MAGNITUDE:g} in SI units; {bad.size} such value(s)); correct those "
+                                "samples, or remove their rows")
 
 
 def _check_alive(path: Path, raw: _Raw, column: str, units: dict) -> None:

@@ -26,6 +26,7 @@ import numpy as np
 
 from clearsim.diagnose.measured import SENSOR_TYPE_UNITS, UNIT_KINDS
 from clearsim.errors import ClearsimError, did_you_mean
+from clearsim.io.files import same_file
 from clearsim.units import UnitError, to_si
 
 FILTER_ORDER = 4
@@ -182,6 +183,9 @@ def synthesize(request: SynthesisRequest) -> Synthesized:
     output = Path(request.output)
     if output.is_dir():
         raise SynthesisError(f"-o {output}: is a folder; give the file to write, e.g. -o {output / 'bench.csv'}")
+    if same_file(output, Path(request.config)):
+        raise SynthesisError(f"-o {output}: that is the mechanism file being read; the record would take its place "
+                             "(--force or not)\n  hint: give the record its own name, e.g. -o bench.csv")
     if output.exists() and not request.force:
         raise SynthesisError(f"{output} exists; choose another -o or pass --force to overwrite it")
     rate, cutoff, offset = _settings(request)

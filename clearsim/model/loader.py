@@ -11,6 +11,8 @@ the first stage stop the load; the later ones are gathered into one InputError.
 
 from __future__ import annotations
 
+import os
+import stat
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -24,14 +26,15 @@ from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 from yaml.reader import ReaderError
 
 from clearsim.errors import InputError, Problem
-from clearsim.model.messages import validation_problems
+from clearsim.model.messages import show, validation_problems
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.paths import locate_error
 from clearsim.model.references import KINDS, check_references
 from clearsim.model.schema import Mechanism, validate_mechanism
+from clearsim.model.yaml_reading import MAX_VALUE_CHARACTERS, CheckedLoader, FastCheckedLoader
 
 MERGE_TAG = "tag:yaml.org,2002:merge"
-FAST_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when PyYAML has it: ~9× faster
+FAST_LOADER = FastCheckedLoader  # libyaml when PyYAML has it: ~9× faster
 FAST_DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # the same text as SafeDumper (checked), 4× faster
 
 
@@ -136,9 +139,13 @@ _SYNTAX_HINTS = {
     "expected a single document": "a mechanism file holds one YAML document: remove the extra '---'",
     "unacceptable character": "remove this character: a YAML file holds printable text only (a stray control "
                               "character, or a binary file)",
+    "cannot read": "a mechanism file is plain YAML: remove the tag (!!...) and write the value itself, e.g. 0.3 kg",
 }
 MAX_NESTING = 50  # levels of mappings and lists; a mechanism file needs 5 (bodies → item → points → name → [x, y])
 MAX_VALUES = 100_000  # values once aliases are expanded; a large mechanism file has a few thousand
+# checking a value with a unit costs time growing with the square of its length (0.04 s at 1000 characters): one
+# value (MAX_VALUE_CHARACTERS) and all of them together, aliases expanded, are bounded
+MAX_TOTAL_CHARACTERS = 2**17  # the bundled files hold 2 000–6 000 characters of values
 # every mapping or list opens with one of these of its own ('- ', 'key:', '? key', '[', '{'), so a text with fewer
 # of them nests less deep than their count; libyaml composes 1000 levels safely (it crashes ~20 000 down)
 COLLECTION_INDICATORS = "-:?[{"
@@ -170,37 +177,52 @@ def _too_deep(position: tuple[int, int]) -> Problem:
                    "never closed, or aliases (*name) inside the blocks they repeat", position=position)
 
 
-def nesting_problem(text: str) -> Problem | None:
-    """Nesting deeper than MAX_NESTING, found in libyaml's events before its recursive composer meets it.
+def nesting_problem(text: str, loader_class=FAST_LOADER) -> Problem | None:
+    """Nesting deeper than MAX_NESTING, found in the parser's events before a recursive composer meets it.
 
-    (libyaml's composer overflows the C stack, a crash, some 20 000 levels down; Python code below recurses too.)
-    A text with fewer than COMPOSABLE_DEPTH collection indicators cannot nest that deep, and is not parsed twice:
-    its nesting beyond MAX_NESTING is found on the composed nodes (alias_problem), at the same place.
+    (libyaml's composer overflows the C stack, a crash, some 20 000 levels down; the pure-Python one overflows
+    Python's stack some 500 levels down.) The parser's YAMLError is raised: a syntax error before any deep nesting,
+    or, from libyaml 0.2.6 on, nesting beyond libyaml's own limit of 1000 levels.
     """
-    if sum(text.count(indicator) for indicator in COLLECTION_INDICATORS) < COMPOSABLE_DEPTH:
-        return None
     depth = 0
-    try:
-        for event in yaml.parse(text, Loader=FAST_LOADER):
-            if isinstance(event, (MappingStartEvent, SequenceStartEvent)):
-                depth += 1
-                if depth > MAX_NESTING:
-                    return _too_deep(_position(event))
-            elif isinstance(event, (MappingEndEvent, SequenceEndEvent)):
-                depth -= 1
-    except yaml.YAMLError:
-        return None  # a syntax error before any deep nesting: the parse that follows reports it
+    for event in yaml.parse(text, Loader=loader_class):
+        if isinstance(event, (MappingStartEvent, SequenceStartEvent)):
+            depth += 1
+            if depth > MAX_NESTING:
+                return _too_deep(_position(event))
+        elif isinstance(event, (MappingEndEvent, SequenceEndEvent)):
+            depth -= 1
     return None
 
 
+def _may_nest_too_deep(text: str) -> bool:
+    """A text with fewer than COMPOSABLE_DEPTH collection indicators cannot nest deep enough to harm libyaml's
+    composer, and is not parsed twice: its nesting beyond MAX_NESTING is found on the composed nodes (alias_problem),
+    at the same place."""
+    return sum(text.count(indicator) for indicator in COLLECTION_INDICATORS) >= COMPOSABLE_DEPTH
+
+
+def _refuse_deep_nesting(text: str, loader_class, file: str | Path) -> None:
+    too_deep = nesting_problem(text, loader_class)
+    if too_deep is not None:
+        raise InputError([too_deep], file)
+
+
+def _too_long(node: ScalarNode) -> Problem:
+    return Problem((), f"invalid YAML: a value of {len(node.value)} characters, more than any setting takes "
+                   f"({MAX_VALUE_CHARACTERS}): {show(node.value)}", "names, numbers, units and file paths are short: "
+                   "look for a missing quote or line break, or a wrong file pasted in", position=_position(node))
+
+
 def alias_problem(root: Node | None) -> Problem | None:
-    """Aliases that make the document contain itself, or expand it beyond MAX_VALUES values or MAX_NESTING levels.
+    """Aliases that make the document contain itself, or expand it beyond MAX_VALUES values, MAX_NESTING levels or
+    MAX_TOTAL_CHARACTERS characters of values; a value longer than MAX_VALUE_CHARACTERS.
 
     Walked without recursion: each of these would otherwise recurse without end or take hours.
     """
     on_path: set[int] = set()
     stack: list[tuple[Node, bool]] = [(root, False)] if root is not None else []
-    values = 0
+    values = characters = 0
     while stack:
         node, leaving = stack.pop()
         if leaving:
@@ -215,6 +237,15 @@ def alias_problem(root: Node | None) -> Problem | None:
             return Problem((), f"invalid YAML: the aliases (*name) expand the file to more than {MAX_VALUES} values",
                            "aliases repeat a block: use them for a few shared blocks, not nested in one another",
                            position=_position(node))
+        if isinstance(node, ScalarNode):
+            if len(node.value) > MAX_VALUE_CHARACTERS:
+                return _too_long(node)
+            characters += len(node.value)
+            if characters > MAX_TOTAL_CHARACTERS:
+                return Problem((), f"invalid YAML: the values of the file, aliases (*name) repeated, add up to more "
+                               f"than {MAX_TOTAL_CHARACTERS} characters", "a mechanism file holds a few thousand "
+                               "characters of values: use aliases for a few shared blocks, and check that this is "
+                               "the right file", position=_position(node))
         if isinstance(node, (SequenceNode, MappingNode)) and len(on_path) >= MAX_NESTING:
             return _too_deep(_position(node))  # an empty list or mapping counts as a level, as in nesting_problem
         children = _children(node)
@@ -256,14 +287,16 @@ def duplicate_keys(node: Node | None, path: tuple = ()) -> list[Problem]:
 
 def parse_yaml(text: str, file: str | Path) -> tuple[dict, SourceMap]:
     """(document, source map); InputError for syntax errors, duplicate keys, a non-mapping top level."""
-    too_deep = nesting_problem(text)
-    if too_deep is not None:
-        raise InputError([too_deep], file)
     try:
+        if _may_nest_too_deep(text):
+            _refuse_deep_nesting(text, FAST_LOADER, file)
         root, document = _compose(text, FAST_LOADER, file)
     except yaml.YAMLError:
-        try:  # the pure-Python parser again, for its messages (the hints above know its wording)
-            root, document = _compose(text, yaml.SafeLoader, file)
+        # a syntax error, or nesting beyond libyaml's own limit: the pure-Python parser again, for its messages (the
+        # hints above know its wording), with no nesting limit of its own; its events first, its composer recurses
+        try:
+            _refuse_deep_nesting(text, CheckedLoader, file)
+            root, document = _compose(text, CheckedLoader, file)
         except yaml.YAMLError as exc:
             raise InputError([_syntax_problem(exc, text)], file) from None
     source = SourceMap.from_node(root)
@@ -374,9 +407,16 @@ MAX_FILE_BYTES = 32 * 2**20  # a mechanism file is a few kB; /dev/zero or a wron
 
 
 def read_mechanism_file(path: Path) -> str:
-    """The text of a mechanism file; InputError when it cannot be read, is not UTF-8 text or is far too large."""
+    """The text of a mechanism file; InputError when it cannot be read, is not a regular file (a FIFO, a device), is
+    not UTF-8 text or is far too large."""
     try:
-        with path.open("rb") as handle:
+        # opened without waiting: a named pipe (FIFO) with no writer would block here for ever
+        with os.fdopen(os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0)), "rb") as handle:
+            kind = _not_regular(os.fstat(handle.fileno()).st_mode)
+            if kind is not None:
+                raise InputError([Problem((), f"cannot read the file: it is {kind}, not a regular file",
+                                          "give the path of the YAML file itself (save what a pipe or a device "
+                                          "would deliver into a file first)")], path)
             data = handle.read(MAX_FILE_BYTES + 1)
     except OSError as exc:
         raise InputError([Problem((), f"cannot read the file: {exc.strerror or exc}", "check the path")], path) from None
@@ -387,6 +427,15 @@ def read_mechanism_file(path: Path) -> str:
         return data.decode("utf-8").replace("\r\n", "\n").replace("\r", "\n")
     except UnicodeDecodeError:
         raise InputError([_not_utf8(data)], path) from None
+
+
+def _not_regular(mode: int) -> str | None:
+    """What a file that is not a regular one is ("a named pipe (FIFO)"), or None for a regular file."""
+    if stat.S_ISREG(mode):
+        return None
+    kinds = {stat.S_ISFIFO: "a named pipe (FIFO)", stat.S_ISCHR: "a device", stat.S_ISBLK: "a device",
+             stat.S_ISSOCK: "a socket", stat.S_ISDIR: "a folder"}
+    return next((kind for test, kind in kinds.items() if test(mode)), "a special file")
 
 
 def _not_utf8(data: bytes) -> Problem:
@@ -417,6 +466,25 @@ def boolean_problems(value: Any, path: tuple = ()) -> list[Problem]:
     return []
 
 
+MAX_OUTPUT_SAMPLES = 1e9  # of each history: 8 GB a value written per sample; a long run writes a few million
+HIGHEST_OUTPUT_RATE = 1e5  # Hz
+
+
+def duration_problems(mechanism: Mechanism) -> list[Problem]:
+    """A t_end (× output_rate) no run could finish or write: refused here, where its line is known, before the run
+    asks the disk for "about inf MB"."""
+    solver = mechanism.solver
+    rate = solver.output_rate or HIGHEST_OUTPUT_RATE  # none written: chosen by the run, at most that
+    samples = solver.t_end * rate
+    if samples <= MAX_OUTPUT_SAMPLES:
+        return []
+    return [Problem(("solver", "t_end"), f"t_end = {solver.t_end:.3g} s at output_rate {rate:.3g} Hz is "
+                    f"{samples:.3g} samples of each history, more than a result file can hold "
+                    f"({MAX_OUTPUT_SAMPLES:.0e})", "t_end is the simulated time: a stroke or a few cycles of a "
+                    "mechanism last milliseconds to seconds (the bundled models: 24 ms and 85 ms), e.g. t_end: 100 ms; "
+                    "or lower solver.output_rate")]
+
+
 def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[str] = (),
                         base_dir: Path | None = None) -> LoadedMechanism:
     """As load_mechanism, from YAML text (`name` is used in messages)."""
@@ -428,7 +496,7 @@ def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[s
     mechanism = None
     try:
         mechanism = validate_mechanism(document)
-        problems += check_references(mechanism)
+        problems += check_references(mechanism) + duration_problems(mechanism)
     except ValidationError as exc:
         problems += validation_problems(exc, document, Mechanism) + _references_of_valid_part(document, exc)
     if problems:

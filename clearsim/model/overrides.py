@@ -23,7 +23,9 @@ import yaml
 from pydantic import BaseModel
 
 from clearsim.errors import Problem, did_you_mean
+from clearsim.model.messages import show
 from clearsim.model.paths import element_type, is_model, member_for_data, strip_type
+from clearsim.model.yaml_reading import MAX_VALUE_CHARACTERS, CheckedLoader
 
 NAMED_LISTS = {"bodies": "body", "joints": "joint", "drivers": "driver", "forces": "force", "sensors": "sensor"}
 EXAMPLE = "joints.J.clearance=0.1mm"
@@ -65,6 +67,9 @@ def apply_override(document: dict, text: str, root: type[BaseModel]) -> tuple:
     segments = key.strip().split(".")
     if not separator or not all(s.strip() for s in segments):
         raise OverrideError("an override is written path=value", f"e.g. --set {EXAMPLE}")
+    if not raw_value.strip():
+        raise OverrideError("no value after '=': an empty value would silently unset the file's value",
+                            f"write the value, e.g. --set {key.strip()}=<value>, or leave this --set out")
     value = parse_value(raw_value)
     cursor = _Cursor(document, root)
     for segment in segments[:-1]:
@@ -84,10 +89,15 @@ def _clearance_keeps_bearing(document: dict, path: tuple) -> None:
 
 def parse_value(raw: str) -> Any:
     """The override's value as YAML; numbers PyYAML keeps as text (1e-8) become floats."""
+    if len(raw) > MAX_VALUE_CHARACTERS:
+        raise OverrideError(f"a value of {len(raw)} characters, more than any setting takes ({MAX_VALUE_CHARACTERS})",
+                            "write the number with its unit, e.g. 0.1mm, or the name")
     try:
-        value = yaml.safe_load(raw)
+        if any(isinstance(event, yaml.AliasEvent) for event in yaml.parse(raw, Loader=CheckedLoader)):
+            raise OverrideError(f"an alias (*name) in the value {show(raw)}", "write the value out in full")
+        value = yaml.load(raw, Loader=CheckedLoader)
     except yaml.YAMLError:
-        raise OverrideError(f"cannot read the value {raw!r}", "quote it, or write it as in the YAML file") from None
+        raise OverrideError(f"cannot read the value {show(raw)}", "quote it, or write it as in the YAML file") from None
     if isinstance(value, str):
         try:
             return float(value)

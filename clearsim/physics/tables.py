@@ -22,6 +22,8 @@ def _column_index(header: list[str], column: str | int, path: Path) -> int:
 
 def _read_rows(path: Path) -> tuple[list[str], np.ndarray]:
     """(header, numeric rows) of a CSV whose first line may be a header."""
+    if path.exists() and not path.is_file():  # a named pipe would block the read for ever, a device never end it
+        raise ValueError(f"table '{path}' is not a regular file (a folder, a named pipe or a device); give the CSV file")
     try:
         with path.open(newline="") as handle:
             lines = [row for row in csv.reader(handle) if row and not row[0].lstrip().startswith("#")]

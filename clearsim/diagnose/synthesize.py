@@ -1,6 +1,6 @@
 """Measured-like data from a model: the way to test diagnosis on data with a known, hidden effect.
 
-The measurement model of DESIGN.md §8, applied in this order:
+The measurement model of docs/diagnose.md, applied in this order:
 
     measured(t_k) = lowpass( sensor(t_k − τ) + noise_k ),   t_k = k / rate,  0 ≤ t_k ≤ t_end + τ
 

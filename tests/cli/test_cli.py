@@ -1,4 +1,4 @@
-"""`clearsim` end to end: the commands of issue #2 on short runs, exit codes and messages."""
+"""`clearsim` end to end: the commands on short runs, exit codes and messages."""
 
 import json
 import os

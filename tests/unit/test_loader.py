@@ -372,7 +372,7 @@ def test_override_values_are_read_as_yaml():
     ("sekunde", ["forces[0] 'push' → time_unit", "unknown unit 'sekunde'"]),
 ])
 def test_a_table_unit_is_a_unit_alone(unit, fragments):
-    """`time_unit: '2 s'` was read as a factor of 2 on the time column (the fuzz of session 7)."""
+    """`time_unit: '2 s'` was read as a factor of 2 on the time column (found by fuzzing)."""
     force = ("forces:\n  - {type: tabulated, name: push, body: slider, direction: [1, 0], file: push.csv, "
              f"time_unit: {unit}}}\n")
     message = load_error(SLIDER_CRANK + force)

@@ -14,7 +14,7 @@ def _kernel_cache_dir() -> str:
 
     numba's own cache notices a change only in the file that defines a function, not in the
     functions it calls from other modules; keying the folder by all sources makes any change
-    recompile everything once (13–26 s on two cores, docs/performance.md) instead of running stale machine code.
+    recompile everything once (12–26 s on two idle cores, docs/performance.md) instead of running stale machine code.
     """
     digest = hashlib.sha256()
     package = Path(__file__).parent

@@ -164,7 +164,7 @@ def _announce_compile() -> None:
 
     if cache_is_cold():
         errors.print("compiling the numerical kernels: the first run of this clearsim version on this machine "
-                     "(13–26 s on two cores depending on the CPU, up to twice as long on one; later runs load them)", soft_wrap=True)
+                     "(12–26 s on two idle cores depending on the CPU, longer on one or on a busy machine; later runs load them)", soft_wrap=True)
 
 
 def _summary_table(report, summary) -> Table:

@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,9 +18,9 @@ import numpy as np
 from clearsim.assembly.build import BuildError
 from clearsim.assembly.system import System, assemble
 from clearsim.errors import ClearsimError, InputError, SolverError, format_path
-from clearsim.io.files import same_file
+from clearsim.io.files import locate, partial_name, publish, same_file
 from clearsim.io.hdf5 import (
-    ResultWriter, check_free_space, group_attribute, interrupts_deferred, keep_as_previous, read_result,
+    ResultWriteError, ResultWriter, check_free_space, group_attribute, interrupts_deferred, read_result,
     result_overview, write_failure,
 )
 from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
@@ -82,13 +83,20 @@ def prepare(loaded: LoadedMechanism) -> System:
 
 @dataclass
 class RunReport:
-    output: Path
+    destination: Path  # the -o of the run
     backup: Path | None
     complete: bool
     status: str
     statistics: object
     error: Exception | None = None
     warnings: list[str] = field(default_factory=list)  # also the result file's `warnings` attribute, a line each
+    identity: os.stat_result | None = None  # of the file written, once it has its name
+
+    @property
+    def output(self) -> Path:
+        """Where this run's file is now: its -o, or the <stem>.previous… name a run that finished later with the same
+        -o moved it to."""
+        return locate(self.destination, self.identity) if self.identity is not None else self.destination
 
 
 def _attributes(system: System, loaded: LoadedMechanism) -> dict:
@@ -136,14 +144,20 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     computed is written when the run ends, fails or is interrupted.
     """
     output = Path(output)
-    check_free_space(output, result_file_bytes(system, contents))
-    backup = keep_as_previous(output)
+    needed = result_file_bytes(system, contents)
+    check_free_space(output, needed)
+    partial = partial_name(output)  # its own file until it is finished: runs with the same -o never meet
     run = None  # made inside the try: loading the compiled kernels can take seconds, and may be interrupted
     episodes, status, complete, error = [], "complete", True, None
     # a state that overflows (absurd masses, speeds, forces) is reported once, by the solver's failure message,
     # not also by numpy's warnings from every place its samples pass through
     attributes = _attributes(system, loaded) | ({} if contents == "all" else {"contents": contents})
-    with np.errstate(all="ignore"), ResultWriter(output, loaded.resolved_yaml, attributes) as writer:
+    try:
+        writer = ResultWriter(partial, loaded.resolved_yaml, attributes)
+    except OSError as exc:
+        partial.unlink(missing_ok=True)
+        raise write_failure(output, exc, needed) from None
+    with np.errstate(all="ignore"), writer:
         pending = _PendingChunks(writer, episodes, system, CONTENTS[contents])
         try:
             run = Run(system, warn)
@@ -156,22 +170,36 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
             at = run.time if run is not None else 0.0
             status, complete, error = f"interrupted at t = {at * 1e3:.3f} ms", False, exc
         except OSError as exc:  # the disk filled up or went away mid-run
-            error = write_failure(output, exc)
+            error = write_failure(output, exc, needed)
             status, complete = f"failed: {error}", False
         finally:
             try:
-                pending.flush()
-                if episodes:
-                    _write_episodes(writer, system, run, np.concatenate(episodes))
+                if not writer.broken:
+                    pending.flush()
+                    if episodes:
+                        _write_episodes(writer, system, run, np.concatenate(episodes))
             except OSError as exc:
-                error = write_failure(output, exc)
-                status, complete = f"failed: {error}", False
-            try:  # whatever failed above, the file is flagged as far as it can still be written
-                writer.finish(complete, status, _final_attributes(run) if run is not None else {})
-            except OSError as exc:
-                error, complete = write_failure(output, exc), False
+                if not isinstance(error, ResultWriteError):  # the first write failure is the one to report
+                    error = write_failure(output, exc, needed)
+                    status, complete = f"failed: {error}", False
+            # whatever failed above, the file is flagged as far as it can still be written
+            readable = writer.finish(complete, status, _final_attributes(run) if run is not None else {})
+    backup, identity = None, None
+    # a run the disk stopped before its first sample leaves nothing: an earlier result keeps its name
+    kept = readable and (writer.rows > 0 or not isinstance(error, ResultWriteError))
+    if kept:
+        with interrupts_deferred():  # the file gets its name whole, even on a Ctrl-C
+            backup = publish(partial, output)
+            identity = output.stat()
+    else:
+        partial.unlink(missing_ok=True)
+    if isinstance(error, ResultWriteError):
+        error = ResultWriteError(output, error.reason, f"{error.hint}; " + (
+            f"the {writer.rows} samples written before are in {output}, flagged complete = false" if kept
+            else "no sample could be written, so no file was left" if readable
+            else "the failed write left the file unreadable, so it was removed"))
     return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
-                     run.warnings() if run is not None else [])
+                     run.warnings() if run is not None else [], identity)
 
 
 def element_place(loaded: LoadedMechanism, element: str | None) -> str:

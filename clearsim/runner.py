@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -20,7 +21,7 @@ from clearsim.assembly.system import System, assemble
 from clearsim.errors import ClearsimError, InputError, SolverError, format_path
 from clearsim.io.files import locate, partial_name, publish, same_file
 from clearsim.io.hdf5 import (
-    ResultWriteError, ResultWriter, check_free_space, group_attribute, interrupts_deferred, read_result,
+    CHUNK_ROWS, ResultWriteError, ResultWriter, check_free_space, group_attribute, interrupts_deferred, read_result,
     result_overview, write_failure,
 )
 from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
@@ -215,8 +216,9 @@ def element_place(loaded: LoadedMechanism, element: str | None) -> str:
 
 def result_file_bytes(system: System, contents: str = "all") -> float:
     """An upper estimate of the result file's size: the datasets of DESIGN.md §6 that `contents` keeps, uncompressed
-    (8 bytes a value where the file keeps full precision, 4 elsewhere), 20 % over."""
-    samples = system.mechanism.solver.t_end * output_rate(system) + 1
+    (8 bytes a value where the file keeps full precision, 4 elsewhere), in whole chunks of CHUNK_ROWS samples (a short
+    run's file holds one whole chunk of every dataset), 20 % over."""
+    samples = math.ceil((system.mechanism.solver.t_end * output_rate(system) + 1) / CHUNK_ROWS) * CHUNK_ROWS
     bodies, clearances = len(system.body_names), len(system.clearance_joints)
     values = {  # a dataset of each kind → values per sample of the kind
         "time": 1,

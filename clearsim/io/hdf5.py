@@ -133,9 +133,12 @@ def new_dataset(parent: h5py.h5g.GroupID, name: str, values: np.ndarray, unit: s
 FINISH_BYTES = 2**18  # kept free by every append: what closing a file takes (its status, episode tables, metadata)
 
 
+CHUNK_ROWS = 1024  # rows per chunk of a growing dataset whose rows are small
+
+
 def chunk_rows_of(values: np.ndarray) -> int:
-    """Rows per chunk of a growing dataset: up to 1024, at most ~1 MB a chunk."""
-    return max(1, min(1024, 2**20 // max(1, values[0].nbytes if values.ndim > 1 else 8)))
+    """Rows per chunk of a growing dataset: CHUNK_ROWS, fewer when that would pass ~1 MB a chunk."""
+    return max(1, min(CHUNK_ROWS, 2**20 // max(1, values[0].nbytes if values.ndim > 1 else 8)))
 
 
 def append_bytes(rows_before: int, values: np.ndarray) -> int:

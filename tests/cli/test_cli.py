@@ -360,18 +360,25 @@ def test_too_little_free_space_exits_2_before_writing(tmp_path, monkeypatch):
 def test_a_disk_that_fills_up_mid_run_exits_2_and_the_file_says_failed(tmp_path, monkeypatch):
     import errno
 
+    from clearsim import runner
     from clearsim.io.hdf5 import ResultWriter
 
-    def full(self, times, datasets):
-        raise OSError(errno.ENOSPC, "No space left on device")
+    real_append = ResultWriter.append
 
-    monkeypatch.setattr(ResultWriter, "append", full)
+    def full_after_the_first(self, times, datasets):
+        if self.rows:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real_append(self, times, datasets)
+
+    monkeypatch.setattr(ResultWriter, "append", full_after_the_first)
+    monkeypatch.setattr(runner, "FLUSH_SECONDS", 0.0)  # every chunk written as it comes
     out = tmp_path / "sc.h5"
     result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=2ms")
     assert result.exit_code == 2, result.output
     assert "the disk is full" in result.output and "Traceback" not in result.output
     with h5py.File(out) as handle:
         assert not handle.attrs["complete"] and "disk is full" in handle.attrs["status"]
+        assert 0 < len(handle["time"]) < 201
 
 
 @pytest.mark.parametrize("command", ["plot", "sweep"])

@@ -46,6 +46,7 @@ class CaseOutcome:
     ran: bool  # False: an earlier result was reused
     error: str = ""
     record: CaseRecord | None = None
+    unwritten: bool = False  # failed as its file could not be written (a full disk): the machine's fault, not the case's
 
 
 _interrupted = False  # this process's case was interrupted (what it raised then is a consequence)
@@ -97,6 +98,8 @@ def _attempt_recorded(task: CaseTask) -> CaseOutcome:
     _interrupted = False
     try:
         return _attempt(task)
+    except ResultWriteError as exc:
+        return CaseOutcome(task.name, FAILED, True, str(exc), unwritten=True)
     except ClearsimError as exc:
         return CaseOutcome(task.name, FAILED, True, str(exc))
     except Exception as exc:  # a bug must not stop the other cases; its text goes to the summary

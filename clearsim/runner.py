@@ -174,33 +174,41 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
             error = write_failure(output, exc, needed)
             status, complete = f"failed: {error}", False
         finally:
-            try:
-                if not writer.broken:
-                    pending.flush()
-                    if episodes:
-                        _write_episodes(writer, system, run, np.concatenate(episodes))
-            except OSError as exc:
-                if not isinstance(error, ResultWriteError):  # the first write failure is the one to report
-                    error = write_failure(output, exc, needed)
-                    status, complete = f"failed: {error}", False
-            # whatever failed above, the file is flagged as far as it can still be written
-            readable = writer.finish(complete, status, _final_attributes(run) if run is not None else {})
+            with interrupts_deferred():  # the file is finished, flagged and named whole, even on a Ctrl-C
+                try:
+                    if not writer.broken:
+                        pending.flush()
+                        if episodes:
+                            _write_episodes(writer, system, run, np.concatenate(episodes))
+                except OSError as exc:
+                    if not isinstance(error, ResultWriteError):  # the first write failure is the one to report
+                        error = write_failure(output, exc, needed)
+                        status, complete = f"failed: {error}", False
+                # whatever failed above, the file is flagged as far as it can still be written
+                readable = writer.finish(complete, status, _final_attributes(run) if run is not None else {})
+                backup, identity, error = _give_its_name(writer, output, readable, error)
+    return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
+                     run.warnings() if run is not None else [], identity)
+
+
+def _give_its_name(writer: ResultWriter, output: Path, readable: bool, error: Exception | None):
+    """Publish the finished file as `output` (an earlier one kept as previous), or remove it when the disk stopped
+    the run before its first sample (an earlier result then keeps its name) or left it unreadable; a write failure
+    then says which. → (where the earlier file went, the file's identity, the error)."""
+    failed_to_write = isinstance(error, ResultWriteError)
+    kept = readable and (writer.rows > 0 or not failed_to_write)
     backup, identity = None, None
-    # a run the disk stopped before its first sample leaves nothing: an earlier result keeps its name
-    kept = readable and (writer.rows > 0 or not isinstance(error, ResultWriteError))
     if kept:
-        with interrupts_deferred():  # the file gets its name whole, even on a Ctrl-C
-            backup = publish(partial, output)
-            identity = output.stat()
+        backup = publish(writer.path, output)
+        identity = output.stat()
     else:
-        partial.unlink(missing_ok=True)
-    if isinstance(error, ResultWriteError):
+        writer.path.unlink(missing_ok=True)
+    if failed_to_write:
         error = ResultWriteError(output, error.reason, f"{error.hint}; " + (
             f"the {writer.rows} samples written before are in {output}, flagged complete = false" if kept
             else "no sample could be written, so no file was left" if readable
             else "the failed write left the file unreadable, so it was removed"))
-    return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
-                     run.warnings() if run is not None else [], identity)
+    return backup, identity, error
 
 
 def element_place(loaded: LoadedMechanism, element: str | None) -> str:

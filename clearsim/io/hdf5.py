@@ -29,18 +29,24 @@ from clearsim.io.files import keep_as_previous, megabytes, room_for  # noqa: F40
 WRITE_HINT = "check that the folder exists and can be written, or choose another file with -o"
 
 
+_deferring = threading.Event()  # set while a block of the main thread holds interrupts
+
+
 @contextlib.contextmanager
 def interrupts_deferred():
-    """Hold Ctrl-C and SIGTERM until the block ends, so a write is never cut in half (main thread only)."""
-    if threading.current_thread() is not threading.main_thread():
+    """Hold Ctrl-C and SIGTERM until the block ends, so a write is never cut in half (main thread only). A block
+    inside another one leaves them held until the outer one ends."""
+    if threading.current_thread() is not threading.main_thread() or _deferring.is_set():
         yield
         return
     received = []
     previous = {sig: signal.signal(sig, lambda number, frame: received.append(number))
                 for sig in (signal.SIGINT, signal.SIGTERM)}
+    _deferring.set()
     try:
         yield
     finally:
+        _deferring.clear()
         for sig, handler in previous.items():
             signal.signal(sig, handler)
         if received:

@@ -230,12 +230,13 @@ def warm_kernels(tmp_path):
 
 
 def _stopped_run(out: Path, *overrides: str) -> tuple[int, bytes]:
-    """`clearsim run` in a process sent SIGTERM a second after its result file appears: (exit code, stderr)."""
+    """`clearsim run` in a process sent SIGTERM a second after its result file appears (under the hidden name it
+    has until the run ends): (exit code, stderr)."""
     command = [sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out)]
     command += [part for override in overrides for part in ("--set", override)]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=os.environ.copy())
     deadline = time.time() + 120
-    while not out.exists() and time.time() < deadline and process.poll() is None:
+    while not list(out.parent.glob(f".{out.name}.*.tmp")) and time.time() < deadline and process.poll() is None:
         time.sleep(0.2)
     time.sleep(1.0)
     process.send_signal(signal.SIGTERM)

@@ -8,6 +8,7 @@ import resource
 import secrets
 import shutil
 from pathlib import Path
+from typing import NamedTuple
 
 try:
     import fcntl
@@ -99,21 +100,32 @@ def _existing_previous(path: Path):
         yield candidate
 
 
-def room_for(path: Path) -> tuple[float, str]:
-    """How many more bytes `path` can take, and what limits it: the free space of its folder's file system or the
-    file size limit of this process (`ulimit -f`), whichever is smaller."""
+class Room(NamedTuple):
+    """How many more bytes a file can take, what limits it ("the disk is full" when that runs out), and how much of
+    it there is ("results has 12 MB free")."""
+
+    bytes: float
+    limit: str
+    left: str
+
+
+def room_for(path: Path) -> Room:
+    """The room left for `path`: the free space of its folder's file system or the file size limit of this process
+    (`ulimit -f`), whichever is smaller."""
     folder = Path(path).parent
     free = shutil.disk_usage(folder).free
+    disk = Room(float(free), "the disk is full", f"{folder} has {megabytes(free)} free")
     limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
     if limit == resource.RLIM_INFINITY:
-        return float(free), f"{folder} has {megabytes(free)} free"
+        return disk
     try:
         size = Path(path).stat().st_size
     except FileNotFoundError:
         size = 0
-    if limit - size < free:
-        return float(max(0, limit - size)), f"the file size limit of this process (ulimit -f) is {megabytes(limit)}"
-    return float(free), f"{folder} has {megabytes(free)} free"
+    if limit - size >= free:
+        return disk
+    return Room(float(max(0, limit - size)), "the file size limit is reached",
+                f"the file size limit of this process (ulimit -f) is {megabytes(limit)}")
 
 
 def megabytes(size: float) -> str:

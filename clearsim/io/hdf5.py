@@ -13,6 +13,7 @@ import contextlib
 import datetime as dt
 import errno
 import math
+import re
 import signal
 import threading
 from collections.abc import Callable
@@ -24,7 +25,7 @@ import numpy as np
 
 from clearsim import __version__
 from clearsim.errors import ClearsimError
-from clearsim.io.files import keep_as_previous, megabytes, room_for  # noqa: F401 (keep_as_previous: re-exported)
+from clearsim.io.files import Room, keep_as_previous, megabytes, room_for  # noqa: F401 (keep_as_previous: re-exported)
 
 WRITE_HINT = "check that the folder exists and can be written, or choose another file with -o"
 
@@ -67,8 +68,8 @@ class ResultWriteError(ClearsimError):
 class NoRoom(OSError):
     """A write refused before it started: the file would outgrow the room left for it (room_for)."""
 
-    def __init__(self, needed: float, limited_by: str):
-        super().__init__(errno.ENOSPC, f"the disk is full: the next write needs {megabytes(needed)} and {limited_by}")
+    def __init__(self, needed: float, room: Room):
+        super().__init__(errno.ENOSPC, f"{room.limit}: the next write needs {megabytes(needed)} and {room.left}")
 
 
 class WriteFailed(OSError):
@@ -79,14 +80,22 @@ FULL_ERRNOS = (errno.ENOSPC, errno.EFBIG, errno.EDQUOT)
 FULL_HINT = "free some space (or raise `ulimit -f`), write elsewhere with -o, or lower solver.output_rate or solver.t_end"
 
 
+def error_number(exc: Exception) -> int | None:
+    """The errno of a failed write: Python's, or the one libhdf5 writes into its message ("errno = 28")."""
+    if getattr(exc, "errno", None):
+        return exc.errno
+    found = re.search(r"errno = (\d+)", str(exc))
+    return int(found.group(1)) if found else None
+
+
 def write_failure(path: Path, exc: OSError, needed_bytes: float | None = None) -> ResultWriteError:
     """The OSError of a write (Python's or libhdf5's) as a ResultWriteError naming the file; for a full disk (or a
     file size limit), with the room left and the room the whole run needs (`needed_bytes`)."""
     if isinstance(exc, NoRoom):
         reason = exc.strerror
-    elif getattr(exc, "errno", None) in FULL_ERRNOS or any(
-            text in str(exc) for text in ("No space left", "File too large", "quota exceeded")):
-        reason = f"the disk is full: {room_for(path)[1]}"
+    elif error_number(exc) in FULL_ERRNOS:
+        room = room_for(path)
+        reason = f"{room.limit}: {room.left}"
     else:
         return ResultWriteError(path, exc.strerror or str(exc))
     if needed_bytes is not None:
@@ -100,11 +109,11 @@ def check_free_space(path: Path, needed_bytes: float) -> None:
     folder = Path(path).parent
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        room, limited_by = room_for(path)
+        room = room_for(path)
     except OSError as exc:
         raise write_failure(path, exc) from None
-    if room < needed_bytes:
-        raise ResultWriteError(path, f"the run writes about {megabytes(needed_bytes)} and {limited_by}", FULL_HINT)
+    if room.bytes < needed_bytes:
+        raise ResultWriteError(path, f"the run writes about {megabytes(needed_bytes)} and {room.left}", FULL_HINT)
 
 
 _WITH_GROUPS = h5py.h5p.create(h5py.h5p.LINK_CREATE)  # a dataset's path creates the groups it names
@@ -194,15 +203,12 @@ class ResultWriter:
             if isinstance(exc, NoRoom):
                 raise
             self.broken = True
-            code = getattr(exc, "errno", None) or next(
-                (number for number, text in ((errno.ENOSPC, "No space left"), (errno.EFBIG, "File too large"))
-                 if text in str(exc)), errno.EIO)
-            raise WriteFailed(code, str(exc)) from None
+            raise WriteFailed(error_number(exc) or errno.EIO, str(exc)) from None
 
     def _make_room(self, needed: float) -> None:
-        room, limited_by = room_for(self.path)
-        if room < needed + FINISH_BYTES:
-            raise NoRoom(needed + FINISH_BYTES, limited_by)
+        room = room_for(self.path)
+        if room.bytes < needed + FINISH_BYTES:
+            raise NoRoom(needed + FINISH_BYTES, room)
 
     def _append(self, name: str, values: np.ndarray, unit: str) -> None:
         if name not in self.created:  # a set, not `name in self.file`: the lookup by path costs as much as the write

@@ -73,11 +73,11 @@ def test_a_file_size_limit_reached_mid_run_leaves_the_samples_written_flagged(tm
     out = tmp_path / "uhv.h5"
     done = clearsim("run", UHV, "-o", out, file_size_limit=6_000_000, patches=[NO_PREFLIGHT, EVERY_CHUNK])
     text = assert_clean_exit_2(done, out)
-    assert "the disk is full: the next write needs" in text and "the whole run needs about" in text
+    assert "the file size limit is reached: the next write needs" in text and "the whole run needs about" in text
     assert f"samples written before are in {out}, flagged complete = false" in text
     with h5py.File(out, "r") as handle:
         assert not handle.attrs["complete"]
-        assert handle.attrs["status"].startswith(f"failed: cannot write the result file {out}: the disk is full")
+        assert handle.attrs["status"].startswith(f"failed: cannot write the result file {out}: the file size limit")
         assert 0 < len(handle["time"]) < UHV_SAMPLES
         assert len(handle["sensors/sealing_rod_displacement"]) == len(handle["time"])
     assert leftovers(tmp_path) == []

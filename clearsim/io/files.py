@@ -57,13 +57,17 @@ def partial_name(path: Path) -> Path:
 @contextlib.contextmanager
 def folder_lock(folder: Path):
     """An exclusive lock on a folder (flock of the folder itself: no lock file left behind), held by one process at
-    a time, for the step that moves an earlier file aside and gives a new one its name."""
+    a time, for the step that moves an earlier file aside and gives a new one its name. Where the file system
+    refuses it (some network file systems), the step runs unlocked: the rename itself is still atomic."""
     if fcntl is None:
         yield
         return
     handle = os.open(folder, os.O_RDONLY)
     try:
-        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX)
+        except OSError:
+            pass
         yield
     finally:
         os.close(handle)  # releases the lock

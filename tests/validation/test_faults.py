@@ -218,3 +218,11 @@ def test_a_published_file_is_found_where_a_later_one_with_its_name_moved_it(tmp_
     assert locate(out, out.stat()) == out and out.read_text() == "second"
     out.write_text("third")
     assert keep_as_previous(out) == tmp_path / "run.previous-2.h5"
+
+
+def test_a_file_being_written_is_no_result_to_the_readers_of_a_folder(tmp_path):
+    from clearsim.plot.sweep import result_files
+
+    (tmp_path / "case.h5").write_bytes(b"")
+    partial_name(tmp_path / "other.h5").write_bytes(b"")
+    assert result_files(tmp_path) == [tmp_path / "case.h5"]

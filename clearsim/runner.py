@@ -199,8 +199,8 @@ def _give_its_name(writer: ResultWriter, output: Path, readable: bool, error: Ex
     kept = readable and (writer.rows > 0 or not failed_to_write)
     backup, identity = None, None
     if kept:
+        identity = writer.path.stat()  # the file's own, kept by the rename (a run finishing next may take the name)
         backup = publish(writer.path, output)
-        identity = output.stat()
     else:
         writer.path.unlink(missing_ok=True)
     if failed_to_write:

@@ -226,3 +226,17 @@ def test_a_file_being_written_is_no_result_to_the_readers_of_a_folder(tmp_path):
     (tmp_path / "case.h5").write_bytes(b"")
     partial_name(tmp_path / "other.h5").write_bytes(b"")
     assert result_files(tmp_path) == [tmp_path / "case.h5"]
+
+
+def test_a_report_reads_its_own_file_after_a_later_run_took_the_name(tmp_path):
+    from clearsim.io.hdf5 import read_attributes
+    from clearsim.model.loader import load_mechanism
+    from clearsim.runner import prepare, run_to_file
+
+    out = tmp_path / "sc.h5"
+    reports = []
+    for t_end in ("1ms", "1.5ms"):
+        loaded = load_mechanism(SLIDER_CRANK, [f"solver.t_end={t_end}"])
+        reports.append(run_to_file(prepare(loaded), loaded, out))
+    assert reports[0].output == tmp_path / "sc.previous.h5" and reports[1].output == out
+    assert "t_end: 1ms\n" in read_attributes(reports[0].output)["config_yaml"]

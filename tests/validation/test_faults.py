@@ -121,6 +121,27 @@ def test_sweep_cases_that_cannot_be_written_fail_with_their_file_and_the_room_ne
     assert "ulimit -f" in text and not list(out.glob("*.h5")) and leftovers(out) == []
 
 
+def test_sweep_cases_stopped_mid_run_keep_their_samples_flagged(tmp_path):
+    """The pool's processes are spawned: the checks are switched off in each by a sitecustomize module."""
+    hooks = tmp_path / "hooks"
+    hooks.mkdir()
+    (hooks / "sitecustomize.py").write_text(f"{NO_PREFLIGHT}\n{EVERY_CHUNK}\n")
+    out = tmp_path / "sweep"
+    done = subprocess.run(
+        [sys.executable, "-m", "clearsim.cli", "sweep", UHV, "--set", "solver.t_end=85ms,84ms", "--no-ideal",
+         "--workers", "2", "-o", str(out)], capture_output=True, text=True, timeout=600,
+        preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (6_000_000, 6_000_000)),
+        env=os.environ | {"PYTHONPATH": str(hooks)})
+    text = done.stdout + done.stderr
+    assert done.returncode == 2, text
+    assert "Traceback" not in text and "worker lost" not in text, text
+    for case in ("solver.t_end-85ms", "solver.t_end-84ms"):
+        assert f"cannot write the result file {out / case}.h5: the file size limit is reached" in text
+        with h5py.File(out / f"{case}.h5", "r") as handle:
+            assert not handle.attrs["complete"] and 0 < len(handle["time"]) < UHV_SAMPLES
+    assert leftovers(out) == []
+
+
 def test_a_diagnosis_whose_runs_cannot_be_written_stops_with_the_file(tmp_path):
     """It said the model 'does not run to the end' (worker lost), as if the model were broken."""
     record = tmp_path / "bench.csv"

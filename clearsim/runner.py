@@ -19,7 +19,7 @@ import numpy as np
 from clearsim.assembly.build import BuildError
 from clearsim.assembly.system import System, assemble
 from clearsim.errors import ClearsimError, InputError, SolverError, format_path
-from clearsim.io.files import locate, partial_name, publish, same_file
+from clearsim.io.files import adopt_abandoned, locate, partial_name, publish, same_file
 from clearsim.io.hdf5 import (
     CHUNK_ROWS, ResultWriteError, ResultWriter, check_free_space, group_attribute, interrupts_deferred, read_result,
     result_overview, write_failure,
@@ -147,6 +147,7 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     output = Path(output)
     needed = result_file_bytes(system, contents)
     check_free_space(output, needed)
+    adopt_abandoned(output)  # a killed run's file: under its name, so that this run keeps it as previous
     partial = partial_name(output)  # its own file until it is finished: runs with the same -o never meet
     run = None  # made inside the try: loading the compiled kernels can take seconds, and may be interrupted
     episodes, status, complete, error = [], "complete", True, None

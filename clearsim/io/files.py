@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 import resource
 import secrets
 import shutil
+import socket
 from pathlib import Path
 from typing import NamedTuple
 
@@ -48,10 +50,40 @@ def previous_names(path: Path):
 
 
 def partial_name(path: Path) -> Path:
-    """A name of its own, in the same folder, for `path` while it is being written: `.<name>.<pid>-<random>.tmp`
-    (hidden, and no reader of results takes it), so that runs writing to one -o never touch each other's file."""
+    """A name of its own, in the same folder, for `path` while it is being written:
+    `.<name>.<host>.<pid>.<random>.tmp` (hidden, and no reader of results takes it), so that runs writing to one -o
+    never touch each other's file."""
     path = Path(path)
-    return path.with_name(f".{path.name}.{os.getpid()}-{secrets.token_hex(4)}{PARTIAL_SUFFIX}")
+    return path.with_name(f".{path.name}.{socket.gethostname()}.{os.getpid()}.{secrets.token_hex(4)}{PARTIAL_SUFFIX}")
+
+
+def abandoned_partials(path: Path) -> list[Path]:
+    """The files being written as `path` by processes of this machine that no longer exist (killed outright)."""
+    path = Path(path)
+    prefix = f".{path.name}.{socket.gethostname()}."
+    found = []
+    for candidate in sorted(path.parent.glob(f".{glob.escape(path.name)}.*{PARTIAL_SUFFIX}")):
+        pid = candidate.name[len(prefix):].split(".")[0] if candidate.name.startswith(prefix) else ""
+        if pid.isdigit() and not _alive(int(pid)):
+            found.append(candidate)
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's
+        return True
+    return True
+
+
+def adopt_abandoned(path: Path) -> None:
+    """Give the files a killed run left being written as `path` that name, as the run itself would have (an earlier
+    file kept as previous): what they hold is flagged `status = running`, and is never left hidden."""
+    for partial in abandoned_partials(path):
+        publish(partial, path)
 
 
 @contextlib.contextmanager

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from clearsim.errors import ClearsimError
+from clearsim.io.files import adopt_abandoned
 from clearsim.io.hdf5 import NotAResultFile, ResultWriteError, keep_as_previous, read_attributes
 from clearsim.model.loader import load_mechanism_text
 from clearsim.process import exit_without_final_collection
@@ -135,6 +136,7 @@ def reused_outcome(task: CaseTask) -> CaseOutcome | None:
 
 
 def _reused(task: CaseTask, loaded) -> CaseOutcome | None:
+    adopt_abandoned(Path(task.output))  # what a killed worker of this machine was writing, judged like any file
     if _reusable(Path(task.output), loaded.resolved_yaml, task.retry_failed, task.contents):
         return _outcome(task.name, Path(task.output), loaded.mechanism.output, ran=False)
     return None

@@ -12,6 +12,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import h5py
@@ -19,7 +20,8 @@ import pytest
 from typer.testing import CliRunner
 
 from clearsim.cli import app
-from clearsim.io.files import keep_as_previous, locate, partial_name, publish
+from clearsim.io.hdf5 import NotAResultFile, read_attributes
+from clearsim.io.files import abandoned_partials, keep_as_previous, locate, partial_name, publish
 
 CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
 SLIDER_CRANK = str(CONFIGS / "slider_crank_flores.yaml")
@@ -229,6 +231,7 @@ def test_a_published_file_is_found_where_a_later_one_with_its_name_moved_it(tmp_
     out = tmp_path / "run.h5"
     first, second = partial_name(out), partial_name(out)
     assert first != second and first.parent == tmp_path and first.name.startswith(".run.h5.")
+    assert abandoned_partials(out) == []  # this process writes them
     assert first.suffix == ".tmp"  # no reader of results (*.h5) takes it for one
     first.write_text("first")
     second.write_text("second")
@@ -250,7 +253,6 @@ def test_a_file_being_written_is_no_result_to_the_readers_of_a_folder(tmp_path):
 
 
 def test_a_report_reads_its_own_file_after_a_later_run_took_the_name(tmp_path):
-    from clearsim.io.hdf5 import read_attributes
     from clearsim.model.loader import load_mechanism
     from clearsim.runner import prepare, run_to_file
 
@@ -261,3 +263,44 @@ def test_a_report_reads_its_own_file_after_a_later_run_took_the_name(tmp_path):
         reports.append(run_to_file(prepare(loaded), loaded, out))
     assert reports[0].output == tmp_path / "sc.previous.h5" and reports[1].output == out
     assert "t_end: 1ms\n" in read_attributes(reports[0].output)["config_yaml"]
+
+
+def test_a_file_left_by_a_killed_run_is_kept_as_previous_by_the_next_run(tmp_path):
+    out = tmp_path / "sc.h5"
+    killed = subprocess.Popen([sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out), "--set",
+                               "solver.t_end=2s", "--set", "solver.output_rate=10kHz"], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while not list(tmp_path.glob(".sc.h5.*.tmp")) and time.monotonic() < deadline and killed.poll() is None:
+        time.sleep(0.1)
+    time.sleep(1.0)  # samples appended meanwhile
+    killed.kill()
+    killed.wait()
+    assert abandoned_partials(out) and not out.exists()
+    done = clearsim("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=1ms")
+    assert done.returncode == 0, done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["sc.h5", "sc.previous.h5"]
+    try:  # killed between two appends, as nearly always, it reads as a run that says it did not end
+        attrs = read_attributes(tmp_path / "sc.previous.h5")
+    except NotAResultFile:  # killed inside a write
+        return
+    assert not attrs["complete"] and attrs["status"] == "running"
+
+
+def test_only_files_of_processes_gone_are_taken_up(tmp_path):
+    import socket
+
+    from clearsim.io.files import adopt_abandoned
+
+    ended = subprocess.Popen(["true"])
+    ended.wait()
+    out = tmp_path / "case.h5"
+    host = socket.gethostname()
+    gone = tmp_path / f".case.h5.{host}.{ended.pid}.0a0a0a0a.tmp"
+    running = tmp_path / f".case.h5.{host}.{os.getpid()}.0b0b0b0b.tmp"
+    elsewhere = tmp_path / f".case.h5.another-{host}.{ended.pid}.0c0c0c0c.tmp"
+    for partial in (gone, running, elsewhere):
+        partial.write_text(partial.name)
+    adopt_abandoned(out)
+    assert out.read_text() == gone.name
+    assert running.exists() and elsewhere.exists() and not gone.exists()

@@ -241,12 +241,15 @@ class ResultWriter:
                 self.file[name][...] = values
 
     def write_table(self, name: str, columns: dict, attributes: dict | None = None) -> None:
+        """A group of equally long columns written whole (NoRoom before anything is written, as for `append`)."""
+        columns = {key: (np.ascontiguousarray(values), unit) for key, (values, unit) in columns.items()}
+        self._make_room(sum(values.nbytes + 4096 for values, _ in columns.values()))
         with self._writing():
             group = self.file.require_group(name)
             for key, (values, unit) in columns.items():
                 if key in group:
                     del group[key]
-                new_dataset(group.id, key, np.ascontiguousarray(values), unit)
+                new_dataset(group.id, key, values, unit)
             for key, value in (attributes or {}).items():
                 group.attrs[key] = value
 

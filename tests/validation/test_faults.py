@@ -304,3 +304,22 @@ def test_only_files_of_processes_gone_are_taken_up(tmp_path):
     adopt_abandoned(out)
     assert out.read_text() == gone.name
     assert running.exists() and elsewhere.exists() and not gone.exists()
+
+
+def test_a_table_that_would_not_fit_is_refused_before_it_is_written(tmp_path, monkeypatch):
+    """A long run's episode tables come after its samples: written into the room kept to close the file, they could
+    fail inside libhdf5 and take the file with them."""
+    import numpy as np
+
+    from clearsim.io import hdf5
+    from clearsim.io.files import Room
+
+    writer = hdf5.ResultWriter(tmp_path / "run.h5", "yaml: text")
+    writer.append(np.arange(3.0), {"sensors/s": (np.ones(3), "m")})
+    episodes = {"onset": (np.zeros(100_000), "s")}
+    monkeypatch.setattr(hdf5, "room_for", lambda path: Room(hdf5.FINISH_BYTES + 700_000, "the disk is full", "…"))
+    with pytest.raises(hdf5.NoRoom):
+        writer.write_table("joints/A/episodes", episodes)
+    assert writer.finish(False, "failed: the disk is full", {})
+    attrs = read_attributes(tmp_path / "run.h5")
+    assert attrs["status"] == "failed: the disk is full"

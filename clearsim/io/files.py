@@ -5,7 +5,6 @@ from __future__ import annotations
 import contextlib
 import glob
 import os
-import resource
 import secrets
 import shutil
 import socket
@@ -14,8 +13,9 @@ from typing import NamedTuple
 
 try:
     import fcntl
-except ImportError:  # not on POSIX: the rename below is still atomic, the keep-as-previous step unlocked
-    fcntl = None
+    import resource
+except ImportError:  # not on POSIX: the rename below is still atomic, the keep-as-previous step unlocked; no ulimit
+    fcntl = resource = None
 
 PARTIAL_SUFFIX = ".tmp"  # a file being written: no reader takes it for a result (they read *.h5)
 
@@ -151,8 +151,8 @@ def room_for(path: Path) -> Room:
     folder = Path(path).parent
     free = shutil.disk_usage(folder).free
     disk = Room(float(free), "the disk is full", f"{folder} has {megabytes(free)} free")
-    limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
-    if limit == resource.RLIM_INFINITY:
+    limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0] if resource is not None else None
+    if limit is None or limit == resource.RLIM_INFINITY:
         return disk
     try:
         size = Path(path).stat().st_size

@@ -73,7 +73,7 @@ def test_a_run_refused_before_it_starts_when_the_file_size_limit_is_too_small(tm
 
 def test_a_file_size_limit_reached_mid_run_leaves_the_samples_written_flagged(tmp_path):
     out = tmp_path / "uhv.h5"
-    done = clearsim("run", UHV, "-o", out, file_size_limit=6_000_000, patches=[NO_PREFLIGHT, EVERY_CHUNK])
+    done = clearsim("run", UHV, "-o", out, file_size_limit=2_000_000, patches=[NO_PREFLIGHT, EVERY_CHUNK])
     text = assert_clean_exit_2(done, out)
     assert "the file size limit is reached: the next write needs" in text and "the whole run needs about" in text
     assert f"samples written before are in {out}, flagged complete = false" in text
@@ -90,7 +90,7 @@ def test_a_write_that_fails_past_the_checks_exits_2_without_a_crash(tmp_path):
     inside libhdf5, the file is closed and flagged, or removed when the failure left it unreadable."""
     out = tmp_path / "uhv.h5"
     out.write_bytes(b"an earlier result")
-    done = clearsim("run", UHV, "-o", out, file_size_limit=6_000_000,
+    done = clearsim("run", UHV, "-o", out, file_size_limit=2_000_000,
                     patches=[NO_PREFLIGHT, EVERY_CHUNK, NO_ROOM_CHECK])
     text = assert_clean_exit_2(done, out)
     assert "the whole run needs about" in text
@@ -132,7 +132,7 @@ def test_sweep_cases_stopped_mid_run_keep_their_samples_flagged(tmp_path):
     done = subprocess.run(
         [sys.executable, "-m", "clearsim.cli", "sweep", UHV, "--set", "solver.t_end=85ms,84ms", "--no-ideal",
          "--workers", "2", "-o", str(out)], capture_output=True, text=True, timeout=600,
-        preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (6_000_000, 6_000_000)),
+        preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (2_000_000, 2_000_000)),
         env=os.environ | {"PYTHONPATH": str(hooks)})
     text = done.stdout + done.stderr
     assert done.returncode == 2, text
@@ -160,10 +160,10 @@ def test_a_diagnosis_whose_runs_cannot_be_written_stops_with_the_file(tmp_path):
 
 @pytest.fixture
 def small_tmpfs(tmp_path):
-    """A 6 MB tmpfs (root, and a kernel that lets it mount one); skipped elsewhere."""
+    """A 2 MB tmpfs (root, and a kernel that lets it mount one); skipped elsewhere."""
     folder = tmp_path / "tmpfs"
     folder.mkdir()
-    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=6m", "tmpfs", str(folder)], capture_output=True)
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(folder)], capture_output=True)
     if mounted.returncode != 0:
         pytest.skip(f"cannot mount a tmpfs here: {mounted.stderr.decode().strip()}")
     try:

@@ -7,6 +7,8 @@
 
 from __future__ import annotations
 
+import math
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,9 +19,9 @@ import numpy as np
 from clearsim.assembly.build import BuildError
 from clearsim.assembly.system import System, assemble
 from clearsim.errors import ClearsimError, InputError, SolverError, format_path
-from clearsim.io.files import same_file
+from clearsim.io.files import adopt_abandoned, locate, partial_name, publish, same_file
 from clearsim.io.hdf5 import (
-    ResultWriter, check_free_space, group_attribute, interrupts_deferred, keep_as_previous, read_result,
+    CHUNK_ROWS, ResultWriteError, ResultWriter, check_free_space, group_attribute, interrupts_deferred, read_result,
     result_overview, write_failure,
 )
 from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
@@ -82,13 +84,20 @@ def prepare(loaded: LoadedMechanism) -> System:
 
 @dataclass
 class RunReport:
-    output: Path
+    destination: Path  # the -o of the run
     backup: Path | None
     complete: bool
     status: str
     statistics: object
     error: Exception | None = None
     warnings: list[str] = field(default_factory=list)  # also the result file's `warnings` attribute, a line each
+    identity: os.stat_result | None = None  # of the file written, once it has its name
+
+    @property
+    def output(self) -> Path:
+        """Where this run's file is now: its -o, or the <stem>.previous… name a run that finished later with the same
+        -o moved it to."""
+        return locate(self.destination, self.identity) if self.identity is not None else self.destination
 
 
 def _attributes(system: System, loaded: LoadedMechanism) -> dict:
@@ -136,14 +145,21 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     computed is written when the run ends, fails or is interrupted.
     """
     output = Path(output)
-    check_free_space(output, result_file_bytes(system, contents))
-    backup = keep_as_previous(output)
+    needed = result_file_bytes(system, contents)
+    check_free_space(output, needed)
+    adopt_abandoned(output)  # a killed run's file: under its name, so that this run keeps it as previous
+    partial = partial_name(output)  # its own file until it is finished: runs with the same -o never meet
     run = None  # made inside the try: loading the compiled kernels can take seconds, and may be interrupted
     episodes, status, complete, error = [], "complete", True, None
     # a state that overflows (absurd masses, speeds, forces) is reported once, by the solver's failure message,
     # not also by numpy's warnings from every place its samples pass through
     attributes = _attributes(system, loaded) | ({} if contents == "all" else {"contents": contents})
-    with np.errstate(all="ignore"), ResultWriter(output, loaded.resolved_yaml, attributes) as writer:
+    try:
+        writer = ResultWriter(partial, loaded.resolved_yaml, attributes)
+    except OSError as exc:
+        partial.unlink(missing_ok=True)
+        raise write_failure(output, exc, needed) from None
+    with np.errstate(all="ignore"), writer:
         pending = _PendingChunks(writer, episodes, system, CONTENTS[contents])
         try:
             run = Run(system, warn)
@@ -156,22 +172,44 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
             at = run.time if run is not None else 0.0
             status, complete, error = f"interrupted at t = {at * 1e3:.3f} ms", False, exc
         except OSError as exc:  # the disk filled up or went away mid-run
-            error = write_failure(output, exc)
+            error = write_failure(output, exc, needed)
             status, complete = f"failed: {error}", False
         finally:
-            try:
-                pending.flush()
-                if episodes:
-                    _write_episodes(writer, system, run, np.concatenate(episodes))
-            except OSError as exc:
-                error = write_failure(output, exc)
-                status, complete = f"failed: {error}", False
-            try:  # whatever failed above, the file is flagged as far as it can still be written
-                writer.finish(complete, status, _final_attributes(run) if run is not None else {})
-            except OSError as exc:
-                error, complete = write_failure(output, exc), False
+            with interrupts_deferred():  # the file is finished, flagged and named whole, even on a Ctrl-C
+                try:
+                    if not writer.broken:
+                        pending.flush()
+                        if episodes:
+                            _write_episodes(writer, system, run, np.concatenate(episodes))
+                except OSError as exc:
+                    if not isinstance(error, ResultWriteError):  # the first write failure is the one to report
+                        error = write_failure(output, exc, needed)
+                        status, complete = f"failed: {error}", False
+                # whatever failed above, the file is flagged as far as it can still be written
+                readable = writer.finish(complete, status, _final_attributes(run) if run is not None else {})
+                backup, identity, error = _give_its_name(writer, output, readable, error)
     return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
-                     run.warnings() if run is not None else [])
+                     run.warnings() if run is not None else [], identity)
+
+
+def _give_its_name(writer: ResultWriter, output: Path, readable: bool, error: Exception | None):
+    """Publish the finished file as `output` (an earlier one kept as previous), or remove it when the disk stopped
+    the run before its first sample (an earlier result then keeps its name) or left it unreadable; a write failure
+    then says which. → (where the earlier file went, the file's identity, the error)."""
+    failed_to_write = isinstance(error, ResultWriteError)
+    kept = readable and (writer.rows > 0 or not failed_to_write)
+    backup, identity = None, None
+    if kept:
+        identity = writer.path.stat()  # the file's own, kept by the rename (a run finishing next may take the name)
+        backup = publish(writer.path, output)
+    else:
+        writer.path.unlink(missing_ok=True)
+    if failed_to_write:
+        error = ResultWriteError(output, error.reason, f"{error.hint}; " + (
+            f"the {writer.rows} samples written before are in {output}, flagged complete = false" if kept
+            else "no sample could be written, so no file was left" if readable
+            else "the failed write left the file unreadable, so it was removed"))
+    return backup, identity, error
 
 
 def element_place(loaded: LoadedMechanism, element: str | None) -> str:
@@ -187,8 +225,9 @@ def element_place(loaded: LoadedMechanism, element: str | None) -> str:
 
 def result_file_bytes(system: System, contents: str = "all") -> float:
     """An upper estimate of the result file's size: the datasets of DESIGN.md §6 that `contents` keeps, uncompressed
-    (8 bytes a value where the file keeps full precision, 4 elsewhere), 20 % over."""
-    samples = system.mechanism.solver.t_end * output_rate(system) + 1
+    (8 bytes a value where the file keeps full precision, 4 elsewhere), in whole chunks of CHUNK_ROWS samples (a short
+    run's file holds one whole chunk of every dataset), 20 % over."""
+    samples = math.ceil((system.mechanism.solver.t_end * output_rate(system) + 1) / CHUNK_ROWS) * CHUNK_ROWS
     bodies, clearances = len(system.body_names), len(system.clearance_joints)
     values = {  # a dataset of each kind → values per sample of the kind
         "time": 1,

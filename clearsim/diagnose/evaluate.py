@@ -16,6 +16,7 @@ from typing import Any, Callable
 import h5py
 import numpy as np
 
+from clearsim.errors import ClearsimError
 from clearsim.model.loader import dump_yaml
 from clearsim.sweep.worker import COMPLETE, CaseTask, run_case
 
@@ -94,6 +95,8 @@ class Evaluator:
 
         def collect(outcome) -> None:
             self.simulations += int(outcome.ran)
+            if outcome.unwritten:  # a full disk: a fault of the machine, not a model that fails
+                raise ClearsimError(outcome.error)
             if outcome.state == COMPLETE:
                 self._memory[outcome.name] = Prediction(*_read_sensors(Path(todo[outcome.name].output)))
             else:

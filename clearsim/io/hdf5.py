@@ -2,8 +2,9 @@
 
 The file is created with `complete = False` and `status = "running"`, every chunk of samples
 is appended and flushed, and `finish()` records the final status. A run that is interrupted
-or fails therefore leaves a readable file that says it is incomplete and why. An existing
-file is never overwritten: it is first renamed to the next free `<stem>.<k>.h5`.
+or fails therefore leaves a readable file that says it is incomplete and why. Before each append the
+writer checks that the disk (and `ulimit -f`) leaves room for it: a write that would fill the disk
+stops the run instead, and the file is closed and flagged while there is still room to do so.
 """
 
 from __future__ import annotations
@@ -11,7 +12,8 @@ from __future__ import annotations
 import contextlib
 import datetime as dt
 import errno
-import shutil
+import math
+import re
 import signal
 import threading
 from collections.abc import Callable
@@ -23,36 +25,29 @@ import numpy as np
 
 from clearsim import __version__
 from clearsim.errors import ClearsimError
+from clearsim.io.files import Room, keep_as_previous, megabytes, room_for  # noqa: F401 (keep_as_previous: re-exported)
 
 WRITE_HINT = "check that the folder exists and can be written, or choose another file with -o"
 
 
-def keep_as_previous(path: Path) -> Path | None:
-    """Rename an existing file (a result, a report, a figure) to <stem>.previous<suffix>, or the first free
-    <stem>.previous-<k><suffix> (k = 2, 3, …) when earlier ones exist: an older kept file is never overwritten, and
-    `clearsim plot` leaves these names out of a folder. Returns the new name (None: nothing was there)."""
-    path = Path(path)
-    if not path.exists():
-        return None
-    backup, k = path.with_name(f"{path.stem}.previous{path.suffix}"), 2
-    while backup.exists():
-        backup, k = path.with_name(f"{path.stem}.previous-{k}{path.suffix}"), k + 1
-    path.rename(backup)
-    return backup
+_deferring = threading.Event()  # set while a block of the main thread holds interrupts
 
 
 @contextlib.contextmanager
 def interrupts_deferred():
-    """Hold Ctrl-C and SIGTERM until the block ends, so a write is never cut in half (main thread only)."""
-    if threading.current_thread() is not threading.main_thread():
+    """Hold Ctrl-C and SIGTERM until the block ends, so a write is never cut in half (main thread only). A block
+    inside another one leaves them held until the outer one ends."""
+    if threading.current_thread() is not threading.main_thread() or _deferring.is_set():
         yield
         return
     received = []
     previous = {sig: signal.signal(sig, lambda number, frame: received.append(number))
                 for sig in (signal.SIGINT, signal.SIGTERM)}
+    _deferring.set()
     try:
         yield
     finally:
+        _deferring.clear()
         for sig, handler in previous.items():
             signal.signal(sig, handler)
         if received:
@@ -70,28 +65,55 @@ class ResultWriteError(ClearsimError):
         return f"cannot write the result file {self.path}: {self.reason}. {self.hint}"
 
 
-def write_failure(path: Path, exc: OSError) -> ResultWriteError:
-    """The OSError of a write (Python's or libhdf5's) as a ResultWriteError naming the file."""
-    reason = exc.strerror or str(exc)
-    if "No space left" in str(exc) or getattr(exc, "errno", None) == errno.ENOSPC:
-        return ResultWriteError(path, "the disk is full", "free some space or write elsewhere with -o; the file keeps "
-                                "what was written before, flagged incomplete if it could still be closed")
-    return ResultWriteError(path, reason)
+class NoRoom(OSError):
+    """A write refused before it started: the file would outgrow the room left for it (room_for)."""
+
+    def __init__(self, needed: float, room: Room):
+        super().__init__(errno.ENOSPC, f"{room.limit}: the next write needs {megabytes(needed)} and {room.left}")
+
+
+class WriteFailed(OSError):
+    """libhdf5 failed to write (its OSError or RuntimeError); the file is left as far as it got."""
+
+
+FULL_ERRNOS = (errno.ENOSPC, errno.EFBIG, errno.EDQUOT)
+FULL_HINT = "free some space (or raise `ulimit -f`), write elsewhere with -o, or lower solver.output_rate or solver.t_end"
+
+
+def error_number(exc: Exception) -> int | None:
+    """The errno of a failed write: Python's, or the one libhdf5 writes into its message ("errno = 28")."""
+    if getattr(exc, "errno", None):
+        return exc.errno
+    found = re.search(r"errno = (\d+)", str(exc))
+    return int(found.group(1)) if found else None
+
+
+def write_failure(path: Path, exc: OSError, needed_bytes: float | None = None) -> ResultWriteError:
+    """The OSError of a write (Python's or libhdf5's) as a ResultWriteError naming the file; for a full disk (or a
+    file size limit), with the room left and the room the whole run needs (`needed_bytes`)."""
+    if isinstance(exc, NoRoom):
+        reason = exc.strerror
+    elif error_number(exc) in FULL_ERRNOS:
+        room = room_for(path)
+        reason = f"{room.limit}: {room.left}"
+    else:
+        return ResultWriteError(path, exc.strerror or str(exc))
+    if needed_bytes is not None:
+        reason += f" (the whole run needs about {megabytes(needed_bytes)})"
+    return ResultWriteError(path, reason, FULL_HINT)
 
 
 def check_free_space(path: Path, needed_bytes: float) -> None:
-    """Make the folder of `path`; ResultWriteError, before anything is written, when it cannot be made or has less
-    free space than needed."""
+    """Make the folder of `path`; ResultWriteError, before anything is written, when it cannot be made or leaves
+    less room than needed (its file system's free space, or the file size limit of `ulimit -f`)."""
     folder = Path(path).parent
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        free = shutil.disk_usage(folder).free
+        room = room_for(path)
     except OSError as exc:
         raise write_failure(path, exc) from None
-    if free < needed_bytes:
-        raise ResultWriteError(path, f"the run writes about {needed_bytes / 2**20:.0f} MB and {folder} has "
-                               f"{free / 2**20:.0f} MB free",
-                               "free some space, write elsewhere with -o, or lower solver.output_rate or solver.t_end")
+    if room.bytes < needed_bytes:
+        raise ResultWriteError(path, f"the run writes about {megabytes(needed_bytes)} and {room.left}", FULL_HINT)
 
 
 _WITH_GROUPS = h5py.h5p.create(h5py.h5p.LINK_CREATE)  # a dataset's path creates the groups it names
@@ -123,34 +145,74 @@ def new_dataset(parent: h5py.h5g.GroupID, name: str, values: np.ndarray, unit: s
     attribute.write(np.array(unit, dtype=h5py.string_dtype("utf-8")))
 
 
+FINISH_BYTES = 2**18  # kept free by every append: what closing a file takes (its status, episode tables, metadata)
+
+
+CHUNK_ROWS = 1024  # rows per chunk of a growing dataset whose rows are small
+
+
+def chunk_rows_of(values: np.ndarray) -> int:
+    """Rows per chunk of a growing dataset: CHUNK_ROWS, fewer when that would pass ~1 MB a chunk."""
+    return max(1, min(CHUNK_ROWS, 2**20 // max(1, values[0].nbytes if values.ndim > 1 else 8)))
+
+
+def append_bytes(rows_before: int, values: np.ndarray) -> int:
+    """The bytes an append of `values` to a chunked dataset of `rows_before` rows allocates: the chunks it starts
+    (whole chunks, at the uncompressed size), and an object header when it creates the dataset."""
+    chunk_rows = chunk_rows_of(values)
+    row_bytes = values[0].nbytes if values.ndim > 1 else values.dtype.itemsize
+    new_chunks = math.ceil((rows_before + len(values)) / chunk_rows) - math.ceil(rows_before / chunk_rows)
+    return new_chunks * chunk_rows * row_bytes + (4096 if rows_before == 0 else 0)
+
+
 class ResultWriter:
-    """Append-only writer of one run's result file."""
+    """Append-only writer of one run's result file.
+
+    No chunk cache (rdcc_nbytes=0): a failed write raises at the write, not later when libhdf5 evicts or frees a
+    dataset (where it could not be caught, and could crash the process). After a failed write (`broken`), the file
+    is closed without further writes and `finish` flags it from a fresh handle, if it can still be read."""
 
     def __init__(self, path: Path, config_yaml: str, attributes: dict | None = None):
         self.path = Path(path)
-        with interrupts_deferred():  # a Ctrl-C here would leave a file without `complete` and `status`
-            try:
-                self.path.parent.mkdir(parents=True, exist_ok=True)
-                self.file = h5py.File(self.path, "w")
-            except OSError as exc:
-                raise write_failure(self.path, exc) from None
-            root = self.file.attrs
-            root["clearsim_version"] = __version__
-            root["created"] = dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
-            root["config_yaml"] = config_yaml
-            root["complete"] = False
-            root["status"] = "running"
-            for key, value in (attributes or {}).items():
-                root[key] = value
-            self.file.flush()
         self.rows = 0
         self.created: set[str] = set()
+        self.broken = False
+        self.file = None
+        with interrupts_deferred():  # a Ctrl-C here would leave a file without `complete` and `status`
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                with self._writing():
+                    self.file = h5py.File(self.path, "w", rdcc_nbytes=0)
+                    self.file.attrs.update({
+                        "clearsim_version": __version__,
+                        "created": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
+                        "config_yaml": config_yaml, "complete": False, "status": "running"} | (attributes or {}))
+                    self.file.flush()
+            except WriteFailed:
+                self._close_quietly()
+                raise
+
+    @contextlib.contextmanager
+    def _writing(self):
+        """libhdf5's failures (OSError, RuntimeError) as WriteFailed; the writer writes nothing more after one."""
+        if self.broken:
+            raise WriteFailed(errno.EIO, "an earlier write to this file failed")
+        try:
+            yield
+        except (OSError, RuntimeError) as exc:
+            if isinstance(exc, NoRoom):
+                raise
+            self.broken = True
+            raise WriteFailed(error_number(exc) or errno.EIO, str(exc)) from None
+
+    def _make_room(self, needed: float) -> None:
+        room = room_for(self.path)
+        if room.bytes < needed + FINISH_BYTES:
+            raise NoRoom(needed + FINISH_BYTES, room)
 
     def _append(self, name: str, values: np.ndarray, unit: str) -> None:
-        values = np.ascontiguousarray(values)
         if name not in self.created:  # a set, not `name in self.file`: the lookup by path costs as much as the write
-            chunk_rows = max(1, min(1024, 2**20 // max(1, values[0].nbytes if values.ndim > 1 else 8)))
-            new_dataset(self.file.id, name, values, unit, chunk_rows)
+            new_dataset(self.file.id, name, values, unit, chunk_rows_of(values))
             self.created.add(name)
             return
         dataset = self.file[name]  # not kept open: an open dataset holds its chunk cache (up to 1 MB) until closed
@@ -159,46 +221,81 @@ class ResultWriter:
         dataset[start:] = values
 
     def append(self, times: np.ndarray, datasets: dict) -> None:
-        """Add samples: /time and every `path → (values, unit)`; flushed to disk at once.
+        """Add samples: /time and every `path → (values, unit)`; flushed to disk at once. NoRoom, before anything
+        is written, when the disk would not keep room to finish the file afterwards.
 
         Hold interrupts around the call (`interrupts_deferred`) when a half-written chunk must not happen."""
-        self._append("time", times, "s")
-        for name, (values, unit) in datasets.items():
-            self._append(name, values, unit)
-        self.rows += len(times)
-        self.file.flush()
+        arrays = {"time": (np.ascontiguousarray(times), "s")} | {
+            name: (np.ascontiguousarray(values), unit) for name, (values, unit) in datasets.items()}
+        self._make_room(sum(append_bytes(self.rows, values) for values, _ in arrays.values()))
+        with self._writing():
+            for name, (values, unit) in arrays.items():
+                self._append(name, values, unit)
+            self.rows += len(times)
+            self.file.flush()
 
     def replace(self, name: str, values: np.ndarray) -> None:
         """Overwrite a whole dataset that was written chunk by chunk (e.g. contact modes once episodes end)."""
-        if name in self.file:
-            self.file[name][...] = values
+        with self._writing():
+            if name in self.file:
+                self.file[name][...] = values
 
     def write_table(self, name: str, columns: dict, attributes: dict | None = None) -> None:
-        group = self.file.require_group(name)
-        for key, (values, unit) in columns.items():
-            if key in group:
-                del group[key]
-            new_dataset(group.id, key, np.ascontiguousarray(values), unit)
-        for key, value in (attributes or {}).items():
-            group.attrs[key] = value
+        """A group of equally long columns written whole (NoRoom before anything is written, as for `append`)."""
+        columns = {key: (np.ascontiguousarray(values), unit) for key, (values, unit) in columns.items()}
+        self._make_room(sum(values.nbytes + 4096 for values, _ in columns.values()))
+        with self._writing():
+            group = self.file.require_group(name)
+            for key, (values, unit) in columns.items():
+                if key in group:
+                    del group[key]
+                new_dataset(group.id, key, values, unit)
+            for key, value in (attributes or {}).items():
+                group.attrs[key] = value
 
-    def finish(self, complete: bool, status: str, attributes: dict) -> None:
-        root = self.file.attrs
-        root["complete"] = bool(complete)
-        root["status"] = status
-        for key, value in attributes.items():
-            root[key] = value
-        self.file.close()
+    def finish(self, complete: bool, status: str, attributes: dict) -> bool:
+        """Record the final status and close; after a failed write, from a fresh handle. False: the file could not
+        be flagged and cannot be read (nothing valid in it)."""
+        final = {"complete": bool(complete), "status": status} | attributes
+        if not self.broken:
+            try:
+                with self._writing():
+                    self.file.attrs.update(final)
+                    self.file.close()
+                return True
+            except WriteFailed:
+                pass
+        self._close_quietly()
+        return flag_after_failure(self.path, final)
+
+    def _close_quietly(self) -> None:
+        if self.file is not None and self.file.id.valid:
+            try:
+                self.file.close()
+            except (OSError, RuntimeError):  # the close fails for the reason the write did
+                pass
 
     def __enter__(self):
         return self
 
     def __exit__(self, *exc):
-        if self.file.id.valid:
-            try:
-                self.file.close()
-            except OSError:  # a failed write was already reported (run_to_file); the close fails for the same reason
-                pass
+        self._close_quietly()
+
+
+def flag_after_failure(path: Path, attributes: dict) -> bool:
+    """Write a failed file's final attributes from a new handle; whether the file can be read (flagged or not: a
+    file that still says `running` is incomplete all the same)."""
+    try:
+        with h5py.File(path, "r+") as handle:
+            handle.attrs.update(attributes)
+        return True
+    except (OSError, RuntimeError):
+        pass
+    try:
+        read_attributes(path)
+        return True
+    except (NotAResultFile, OSError, RuntimeError):
+        return False
 
 
 class NotAResultFile(ValueError):

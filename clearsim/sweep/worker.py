@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from clearsim.errors import ClearsimError
+from clearsim.io.files import adopt_abandoned
 from clearsim.io.hdf5 import NotAResultFile, ResultWriteError, keep_as_previous, read_attributes
 from clearsim.model.loader import load_mechanism_text
 from clearsim.process import exit_without_final_collection
@@ -46,6 +47,7 @@ class CaseOutcome:
     ran: bool  # False: an earlier result was reused
     error: str = ""
     record: CaseRecord | None = None
+    unwritten: bool = False  # failed as its file could not be written (a full disk): the machine's fault, not the case's
 
 
 _interrupted = False  # this process's case was interrupted (what it raised then is a consequence)
@@ -97,6 +99,8 @@ def _attempt_recorded(task: CaseTask) -> CaseOutcome:
     _interrupted = False
     try:
         return _attempt(task)
+    except ResultWriteError as exc:
+        return CaseOutcome(task.name, FAILED, True, str(exc), unwritten=True)
     except ClearsimError as exc:
         return CaseOutcome(task.name, FAILED, True, str(exc))
     except Exception as exc:  # a bug must not stop the other cases; its text goes to the summary
@@ -132,6 +136,7 @@ def reused_outcome(task: CaseTask) -> CaseOutcome | None:
 
 
 def _reused(task: CaseTask, loaded) -> CaseOutcome | None:
+    adopt_abandoned(Path(task.output))  # what a killed worker of this machine was writing, judged like any file
     if _reusable(Path(task.output), loaded.resolved_yaml, task.retry_failed, task.contents):
         return _outcome(task.name, Path(task.output), loaded.mechanism.output, ran=False)
     return None

@@ -230,12 +230,13 @@ def warm_kernels(tmp_path):
 
 
 def _stopped_run(out: Path, *overrides: str) -> tuple[int, bytes]:
-    """`clearsim run` in a process sent SIGTERM a second after its result file appears: (exit code, stderr)."""
+    """`clearsim run` in a process sent SIGTERM a second after its result file appears (under the hidden name it
+    has until the run ends): (exit code, stderr)."""
     command = [sys.executable, "-m", "clearsim.cli", "run", SLIDER_CRANK, "-o", str(out)]
     command += [part for override in overrides for part in ("--set", override)]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=os.environ.copy())
     deadline = time.time() + 120
-    while not out.exists() and time.time() < deadline and process.poll() is None:
+    while not list(out.parent.glob(f".{out.name}.*.tmp")) and time.time() < deadline and process.poll() is None:
         time.sleep(0.2)
     time.sleep(1.0)
     process.send_signal(signal.SIGTERM)
@@ -360,18 +361,25 @@ def test_too_little_free_space_exits_2_before_writing(tmp_path, monkeypatch):
 def test_a_disk_that_fills_up_mid_run_exits_2_and_the_file_says_failed(tmp_path, monkeypatch):
     import errno
 
+    from clearsim import runner
     from clearsim.io.hdf5 import ResultWriter
 
-    def full(self, times, datasets):
-        raise OSError(errno.ENOSPC, "No space left on device")
+    real_append = ResultWriter.append
 
-    monkeypatch.setattr(ResultWriter, "append", full)
+    def full_after_the_first(self, times, datasets):
+        if self.rows:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real_append(self, times, datasets)
+
+    monkeypatch.setattr(ResultWriter, "append", full_after_the_first)
+    monkeypatch.setattr(runner, "FLUSH_SECONDS", 0.0)  # every chunk written as it comes
     out = tmp_path / "sc.h5"
     result = invoke("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=2ms")
     assert result.exit_code == 2, result.output
     assert "the disk is full" in result.output and "Traceback" not in result.output
     with h5py.File(out) as handle:
         assert not handle.attrs["complete"] and "disk is full" in handle.attrs["status"]
+        assert 0 < len(handle["time"]) < 201
 
 
 @pytest.mark.parametrize("command", ["plot", "sweep"])

@@ -22,7 +22,7 @@ VICTIM = "clearance-0.2_mm"
 
 
 def _kill_when_written(path: Path, signum: int) -> None:
-    while not path.exists():
+    while not list(path.parent.glob(f".{path.name}.*.tmp")):  # the file being written, under its hidden name
         time.sleep(0.001)
     os.kill(os.getpid(), signum)
 

@@ -33,7 +33,7 @@ from clearsim.solver import precompile
 
 BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
 # which per-sample histories a result file holds (its `contents` attribute, absent for "all"), each a subset of the
-# one before: every dataset of DESIGN.md §6; "summary", all but the bodies' q, q̇, q̈ and the ideal joints' reactions
+# one before: every dataset of the result layout (README); "summary", all but the bodies' q, q̇, q̈ and the ideal joints' reactions
 # — what a sweep's summary table and `clearsim plot`'s figures read (`clearsim sweep --keep summary`; a UHV case at
 # 100 kHz 4.4 → 1.3 MB); or the sensors alone — a diagnosis reads nothing else of its model runs (0.31 MB). The
 # contact modes' episode tables and the run's attributes are in every file.
@@ -224,7 +224,7 @@ def element_place(loaded: LoadedMechanism, element: str | None) -> str:
 
 
 def result_file_bytes(system: System, contents: str = "all") -> float:
-    """An upper estimate of the result file's size: the datasets of DESIGN.md §6 that `contents` keeps, uncompressed
+    """An upper estimate of the result file's size: the datasets of the result layout that `contents` keeps, uncompressed
     (8 bytes a value where the file keeps full precision, 4 elsewhere), in whole chunks of CHUNK_ROWS samples (a short
     run's file holds one whole chunk of every dataset), 20 % over."""
     samples = math.ceil((system.mechanism.solver.t_end * output_rate(system) + 1) / CHUNK_ROWS) * CHUNK_ROWS

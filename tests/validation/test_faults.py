@@ -47,6 +47,14 @@ def clearsim(*args, file_size_limit: int | None = None, patches=(), cwd=None) ->
                           preexec_fn=limit, cwd=cwd, env=os.environ.copy())
 
 
+@pytest.fixture(scope="module", autouse=True)
+def compiled_kernels(tmp_path_factory):
+    """The kernels in the cache before any child runs under a file size limit (which would fail to write them)."""
+    out = tmp_path_factory.mktemp("warm") / "warm.h5"
+    done = clearsim("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=0.1ms")
+    assert done.returncode == 0, done.stdout + done.stderr
+
+
 def assert_clean_exit_2(done: subprocess.CompletedProcess, path: Path) -> str:
     """Exit 2, one message naming the file, no traceback (a SIGSEGV is -11, an uncaught exception 1)."""
     text = done.stdout + done.stderr
@@ -64,11 +72,20 @@ def test_a_run_refused_before_it_starts_when_the_file_size_limit_is_too_small(tm
     """It died with SIGSEGV, or an h5py RuntimeError traceback, leaving status = 'running'."""
     out = tmp_path / "sc.h5"
     out.write_bytes(b"an earlier result")
-    done = clearsim("run", SLIDER_CRANK, "-o", out, file_size_limit=500_000)
+    done = clearsim("run", SLIDER_CRANK, "-o", out, file_size_limit=100_000)
     text = assert_clean_exit_2(done, out)
-    assert "the file size limit of this process (ulimit -f) is 0.477 MB" in text and "the run writes about" in text
+    assert "the file size limit of this process (ulimit -f) is 0.0954 MB" in text and "the run writes about" in text
     assert out.read_bytes() == b"an earlier result"  # not moved aside: nothing was written
     assert sorted(p.name for p in tmp_path.iterdir()) == ["sc.h5"]
+
+
+def test_a_run_whose_compressed_file_fits_is_not_refused_by_its_uncompressed_size(tmp_path):
+    """The check before the run counted the uncompressed histories (2.2 MB here) and refused a 0.5 MB file."""
+    out = tmp_path / "sc.h5"
+    done = clearsim("run", SLIDER_CRANK, "-o", out, "--set", "solver.t_end=2ms", file_size_limit=1_000_000)
+    assert done.returncode == 0, done.stdout + done.stderr
+    with h5py.File(out, "r") as handle:
+        assert bool(handle.attrs["complete"]) and out.stat().st_size < 1_000_000
 
 
 def test_a_file_size_limit_reached_mid_run_leaves_the_samples_written_flagged(tmp_path):
@@ -114,7 +131,7 @@ def test_sweep_cases_that_cannot_be_written_fail_with_their_file_and_the_room_ne
     """The pool's processes died (`worker lost: BrokenProcessPool`, no file named)."""
     out = tmp_path / "sweep"
     done = clearsim("sweep", SLIDER_CRANK, "--set", "solver.t_end=2ms,3ms", "--no-ideal", "--workers", 2, "-o", out,
-                    file_size_limit=1_000_000)
+                    file_size_limit=100_000)
     text = done.stdout + done.stderr
     assert done.returncode == 2, text
     assert "Traceback" not in text and "worker lost" not in text, text
@@ -151,7 +168,7 @@ def test_a_diagnosis_whose_runs_cannot_be_written_stops_with_the_file(tmp_path):
                                            "--rate", "20kHz", "--seed", "1", "-o", str(record)])
     assert synthesized.exit_code == 0, synthesized.output
     done = clearsim("diagnose", SLIDER_CRANK, "--measured", record, "-o", tmp_path / "report", "--workers", 1,
-                    "--candidates", "clearance", file_size_limit=1_000_000)
+                    "--candidates", "clearance", file_size_limit=20_000)
     text = done.stdout + done.stderr
     assert done.returncode == 2, text
     assert "Traceback" not in text and "does not run to the end" not in text, text

@@ -206,6 +206,7 @@ class _Batch:
     def submit(self, indices) -> None:
         for index in indices:
             self.futures[self.pool.executor.submit(_tracked, self.function, index, self.tasks[index])] = index
+        _watch_every_process(self.pool.executor)
 
     def collect_finished(self, interrupted: bool) -> None:
         done, _ = wait(self.futures, return_when=FIRST_COMPLETED)
@@ -241,6 +242,16 @@ class _Batch:
                 again.append(index)
         self.futures, self.pool = {}, self.new_pool()  # its processes start with the first case submitted
         self.submit(again)
+
+
+def _watch_every_process(pool: ProcessPoolExecutor) -> None:
+    """Have the pool's manager thread watch every process it has now. `submit` wakes that thread before it starts
+    a process: a thread that woke first waits on the processes it knew then and does not see a later one die
+    until some case's result arrives, while the case of the dead process stays pending. Woken here as `submit`
+    does, under the pool's lock (a broken pool closes the wakeup under it)."""
+    with pool._shutdown_lock:
+        if pool._executor_manager_thread_wakeup is not None:
+            pool._executor_manager_thread_wakeup.wakeup()
 
 
 def _interrupt_workers(pool: ProcessPoolExecutor) -> None:

@@ -7,6 +7,7 @@ import os
 import signal
 import threading
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import h5py
@@ -102,16 +103,38 @@ def _b_ends_in_order_a_is_killed(folder: str, task: CaseTask) -> CaseOutcome:
     return CaseOutcome(task.name, FAILED, True, "never ended by the pool")
 
 
-def test_a_case_the_pool_ended_in_order_after_the_death_is_not_blamed_for_it(tmp_path, monkeypatch):
+def _run_b_then_a(folder: Path, monkeypatch) -> dict[str, CaseOutcome]:
     from clearsim.solver import precompile
 
     monkeypatch.setattr(precompile, "cache_is_cold", lambda: False)  # a cold cache would hold a back until b ends
     collected = {}
     tasks = [CaseTask(name, "", "", "", (), "") for name in ("b", "a")]
-    assert not LocalPool(2).run(functools.partial(_b_ends_in_order_a_is_killed, str(tmp_path)), tasks,
+    assert not LocalPool(2).run(functools.partial(_b_ends_in_order_a_is_killed, str(folder)), tasks,
                                 lambda outcome: collected.setdefault(outcome.name, outcome))
+    return collected
+
+
+def test_a_case_the_pool_ended_in_order_after_the_death_is_not_blamed_for_it(tmp_path, monkeypatch):
+    collected = _run_b_then_a(tmp_path, monkeypatch)
     assert (collected["a"].state, collected["a"].error) == (FAILED, "worker killed by signal 9 (SIGKILL) while "
                                                                      "running this case")
+    assert collected["b"].state == COMPLETE, collected["b"].error
+
+
+def test_the_death_of_a_process_started_after_the_pool_began_waiting_is_seen_at_once(tmp_path, monkeypatch):
+    """The pool starts a process per case submitted, after waking its manager thread: a thread that woke before
+    the second process started waits on the first alone. Its death must still end b at once (b is not left to
+    sleep its 60 s and be collected as `never ended by the pool`)."""
+    spawn = ProcessPoolExecutor._spawn_process
+
+    def second_starts_late(executor):
+        if executor._processes:
+            time.sleep(0.5)  # the manager thread, woken by the submit, is waiting again by then
+        spawn(executor)
+
+    monkeypatch.setattr(ProcessPoolExecutor, "_spawn_process", second_starts_late)
+    collected = _run_b_then_a(tmp_path, monkeypatch)
+    assert collected["a"].error == "worker killed by signal 9 (SIGKILL) while running this case"
     assert collected["b"].state == COMPLETE, collected["b"].error
 
 

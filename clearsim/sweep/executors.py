@@ -249,9 +249,12 @@ def _watch_every_process(pool: ProcessPoolExecutor) -> None:
     a process: a thread that woke first waits on the processes it knew then and does not see a later one die
     until some case's result arrives, while the case of the dead process stays pending. Woken here as `submit`
     does, under the pool's lock (a broken pool closes the wakeup under it)."""
+    if not isinstance(pool, ProcessPoolExecutor):
+        return  # a pool of threads: no processes to watch
     with pool._shutdown_lock:
-        if pool._executor_manager_thread_wakeup is not None:
-            pool._executor_manager_thread_wakeup.wakeup()
+        wakeup = getattr(pool, "_executor_manager_thread_wakeup", None)  # None once the pool is shut down
+        if wakeup is not None:
+            wakeup.wakeup()
 
 
 def _interrupt_workers(pool: ProcessPoolExecutor) -> None:

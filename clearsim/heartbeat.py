@@ -6,7 +6,7 @@ sweep or diagnosis would say nothing for minutes. A `Heartbeat` keeps the latest
 or not anything changed meanwhile (a sweep's case or a diagnosis's batch can take minutes): what is done of how
 much, the elapsed time and, when `total` is known, the time left at the pace since the first update (not since the
 start: loading or compiling the kernels comes before it). The interval is $CLEARSIM_HEARTBEAT_SECONDS (default
-10 s).
+10 s). A progress given since the last line is written when the heartbeat stops, so a log ends with the final state.
 """
 
 from __future__ import annotations
@@ -59,6 +59,7 @@ class Heartbeat:
         self.last = self.started
         self.progress, self.done, self.total = "starting", 0.0, None
         self.first: tuple[float, float] | None = None  # (time, done) of the first update: the pace is measured from it
+        self.unwritten = False  # a progress was given since the last line
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._ticker: threading.Thread | None = None
@@ -69,17 +70,18 @@ class Heartbeat:
             if self.first is None:
                 self.first = (self.clock(), done)
             self.progress, self.done, self.total = progress, done, total
+            self.unwritten = True
         self.beat()
 
-    def beat(self) -> None:
-        """Write the latest progress if the interval has passed since the last line."""
+    def beat(self, final: bool = False) -> None:
+        """Write the latest progress if the interval has passed since the last line (final: if it is unwritten)."""
         if not self.enabled:
             return
         with self._lock:
             now = self.clock()
-            if now - self.last < self.interval:
+            if (not self.unwritten) if final else (now - self.last < self.interval):
                 return
-            self.last = now
+            self.last, self.unwritten = now, False
             line = self.line(now)
         self.write(line)
 
@@ -102,6 +104,7 @@ class Heartbeat:
         self._stop.set()
         if self._ticker is not None:
             self._ticker.join()
+        self.beat(final=True)
 
     def _tick(self) -> None:
         while not self._stop.wait(max(self.interval, SHORTEST_SECONDS)):

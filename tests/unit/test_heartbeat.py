@@ -70,3 +70,18 @@ def test_sweep_prints_heartbeat_lines_when_its_output_is_not_a_terminal(tmp_path
     assert "clearsim sweep: 0 of 2 cases finished" in result.output
     assert re.search(r"^clearsim sweep: 2 of 2 cases finished \(last: .*: complete\), [\d.]+ s elapsed", result.output,
                      re.M), result.output
+
+
+def test_the_last_progress_is_written_when_the_heartbeat_stops_and_only_if_unwritten():
+    """A sweep whose last case ended between two beats left its log at '1 of 2 cases finished'."""
+    clock, lines = Clock(), []
+    with Heartbeat(lines.append, "clearsim sweep", interval=60.0, clock=clock) as beat:
+        clock.now += 61.0
+        beat.update("1 of 2 cases finished", 1.0, 2.0)
+        clock.now += 1.0
+        beat.update("2 of 2 cases finished", 2.0, 2.0)
+    assert lines == ["clearsim sweep: 1 of 2 cases finished, 1 min 01 s elapsed",
+                     "clearsim sweep: 2 of 2 cases finished, 1 min 02 s elapsed, about 0.0 s left"]
+    with Heartbeat(lines.append, "clearsim sweep", interval=0.0, clock=clock) as beat:
+        beat.update("2 of 2 cases finished", 2.0, 2.0)
+    assert len(lines) == 3  # written at the update: not again at the stop

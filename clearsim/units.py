@@ -90,6 +90,7 @@ DIMENSIONS = {
     "angular_speed": Dimension("angular speed", "rad/s", _dims(time=-1), "5000 rpm"),
     "force": Dimension("force", "N", _dims(mass=1, length=1, time=-2), "100 N"),
     "torque": Dimension("torque", "N*m", _dims(mass=1, length=2, time=-2), "20 N*m"),
+    "area": Dimension("area", "m^2", _dims(length=2), "3.1e-3 m^2"),
     "pressure": Dimension("pressure (modulus)", "Pa", _dims(mass=1, length=-1, time=-2), "207 GPa"),
     "spring_stiffness": Dimension("spring stiffness", "N/m", _dims(mass=1, time=-2), "1e5 N/m"),
     "damping": Dimension("damping coefficient", "N*s/m", _dims(mass=1, time=-1), "50 N*s/m"),
@@ -105,6 +106,7 @@ DERIVED_UNITS = {  # the other kinds, built from the base ones unless the block 
     "frequency": "1/{time}",
     "inertia": "{mass}*{length}^2",
     "torque": "{force}*{length}",
+    "area": "{length}^2",
     "pressure": "{force}/{length}^2",
     "spring_stiffness": "{force}/{length}",
     "damping": "{force}*{time}/{length}",
@@ -403,6 +405,7 @@ Angle = _quantity_type("angle")
 AngularSpeed = _quantity_type("angular_speed")
 Force = _quantity_type("force")
 Torque = _quantity_type("torque")
+Area = _quantity_type("area")
 Pressure = _quantity_type("pressure")
 SpringStiffness = _quantity_type("spring_stiffness")
 Damping = _quantity_type("damping")

@@ -16,16 +16,17 @@ from typing import Callable
 
 import numpy as np
 
-from clearsim.assembly.build import BuildError, initial_poses, joint_points
+from clearsim.assembly.build import BuildError
 from clearsim.assembly.arrays import for_kernels
 from clearsim.assembly.dynamics import accelerations, generalized_forces
 from clearsim.assembly.system import assemble
 from clearsim.diagnose.evaluate import document_text
 from clearsim.errors import ClearsimError
+from clearsim.model.flexible import LinkSplit, link_split, point_text, set_spring, split_link, two_joint_links
 from clearsim.model.loader import load_mechanism_text
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.resolve import is_clearance_joint, resolve_clearance
-from clearsim.model.schema import Mechanism, PrismaticJoint, SpringDamper, StrokeMotion
+from clearsim.model.schema import Mechanism, StrokeMotion
 from clearsim.units import si_text, to_si
 
 FAR_ANCHOR = 1000.0  # m: a damper anchored this far along its line acts in a fixed direction
@@ -250,7 +251,7 @@ def damping(mechanism, document) -> list[Candidate]:
         forces = doc.setdefault("forces", []) or []
         doc["forces"] = [f for f in forces if f.get("name") != "diagnose_damping"] + [{
             "type": "spring_damper", "name": "diagnose_damping", "bodies": ["ground", body.name],
-            "at": [_point_text(anchor), _point_text(where)], "damping": si_text(value, "damping")}]
+            "at": [point_text(anchor), point_text(where)], "damping": si_text(value, "damping")}]
 
     return [Candidate("damping", body.name, "damping", "N*s/m", 1e-3 * scale, 10.0 * scale, True, None, write,
                       ("N·s/m", 1.0))]
@@ -275,132 +276,6 @@ COMPLIANCE_BOUNDS = (1e6, 1e10)  # N/m: a soft composite pull rod (≈ 1 MN/m) t
 COMPLIANCE_DAMPING_RATIO = 0.02  # structural damping of the axial mode, 2 % of critical (bolted steel, GFRP: 1–5 %)
 
 
-@dataclass(frozen=True)
-class LinkSplit:
-    """How a two-joint link becomes two halves sliding along the line between its joints.
-
-    The half at the first joint (in file order) keeps the body's name; the other is new. Both start
-    with the body's pose, centre of mass and body points, half its mass and half its inertia, so the
-    pair has the link's mass, centre of mass and inertia, and a stiff spring gives the rigid link back.
-    """
-
-    body: str
-    half: str  # the new body, at the second joint
-    near: tuple[float, float]  # global location of the first joint at t = 0
-    far: tuple[float, float]  # of the second
-    moved_joint: str  # the second joint: its reference to the body goes to the new half
-    moved_sensors: frozenset  # point sensors nearer the second joint
-    moved_ends: dict  # force name → indices of its ends on the body nearer the second joint (single-body force: (0,))
-    mass: float  # kg, of the whole link
-    inertia: float  # kg·m², of the whole link
-    tension: float = 0.0  # N: the rigid link's axial tension at t = 0, carried by the spring from the start
-
-    @property
-    def guide(self) -> str:
-        return f"{self.body}_stretch"
-
-    @property
-    def spring(self) -> str:
-        return f"{self.body}_compliance"
-
-    @property
-    def length(self) -> float:
-        return float(np.hypot(self.far[0] - self.near[0], self.far[1] - self.near[1]))
-
-
-def _two_joint_links(mechanism) -> list[tuple[str, list]]:
-    """Bodies with exactly two revolute joints, in no prismatic joint and driven by no body driver."""
-    revolute = {b.name: [] for b in mechanism.bodies}
-    excluded = {d.body for d in mechanism.drivers if d.body is not None}
-    for joint in mechanism.joints:
-        for name in set(joint.bodies) & set(revolute):
-            if isinstance(joint, PrismaticJoint):
-                excluded.add(name)
-            else:
-                revolute[name].append(joint)
-    return [(name, joints) for name, joints in revolute.items() if len(joints) == 2 and name not in excluded]
-
-
-def _joint_location(mechanism, poses, joint, body: str) -> np.ndarray:
-    """Where the joint sits on `body`, globally, at t = 0 (as the assembly reads `at:` or `points:`)."""
-    _, _, si, sj = joint_points(poses, joint, ("joints", mechanism.joints.index(joint)))
-    return poses.to_global(poses.index[body], si if joint.bodies[0] == body else sj)
-
-
-def _force_ends(poses, force, body: str) -> list[tuple[int, np.ndarray]]:
-    """(end index, global location at t = 0) of each end of a force that acts on `body`."""
-    index = poses.index[body]
-    if not isinstance(force, SpringDamper):
-        return [(0, poses.point_global(force.point, index, ()))] if force.body == body else []
-    ends = []
-    for end, name in enumerate(force.bodies):
-        if name != body:
-            continue
-        if force.points is not None:
-            ends.append((end, poses.to_global(index, poses.named_body_point(body, force.points[end], ())[0])))
-        else:
-            ends.append((end, poses.point_global(force.at[end] if force.at is not None else None, index, ())))
-    return ends
-
-
-def link_split(mechanism, body: str, joints: list) -> LinkSplit | None:
-    """The split of a two-joint link; None when its joints coincide or the new names are taken."""
-    poses = initial_poses(mechanism)
-    near, far = (_joint_location(mechanism, poses, j, body) for j in joints)
-    axis = far - near
-    if np.linalg.norm(axis) < 1e-9:
-        return None
-
-    def nearer_far(point) -> bool:
-        return float(np.dot(np.asarray(point, float) - near, axis)) > 0.5 * float(np.dot(axis, axis))
-
-    sensors = frozenset(s.name for s in mechanism.sensors if getattr(s, "body", None) == body and hasattr(s, "point")
-                        and nearer_far(poses.point_global(s.point, poses.index[body], ())))
-    moved = {f.name: tuple(end for end, where in _force_ends(poses, f, body) if nearer_far(where)) for f in mechanism.forces}
-    split = LinkSplit(body, f"{body}_{joints[1].name}_half", tuple(near.tolist()), tuple(far.tolist()), joints[1].name, sensors,
-                      {name: ends for name, ends in moved.items() if ends}, mechanism.body(body).mass,
-                      mechanism.body(body).inertia)
-    taken = {b.name for b in mechanism.bodies} | {j.name for j in mechanism.joints} | {f.name for f in mechanism.forces}
-    return None if {split.half, split.guide, split.spring} & taken else split
-
-
-def split_link(document: dict, split: LinkSplit) -> None:
-    """Make the link two halves joined by a prismatic joint along it and a spring-damper (no force yet)."""
-    bodies = document["bodies"]
-    position = next(i for i, b in enumerate(bodies) if b["name"] == split.body)
-    near = bodies[position]
-    near["mass"] = si_text(split.mass / 2.0, "mass")
-    near["inertia"] = si_text(split.inertia / 2.0, "inertia")
-    bodies.insert(position + 1, {**copy.deepcopy(near), "name": split.half})
-
-    def moved(names, ends):
-        return [split.half if k in ends and n == split.body else n for k, n in enumerate(names)]
-
-    for joint in document["joints"]:
-        if joint["name"] == split.moved_joint:
-            joint["bodies"] = moved(joint["bodies"], (0, 1))
-    for sensor in document.get("sensors") or []:
-        if sensor["name"] in split.moved_sensors:
-            sensor["body"] = split.half
-    for force in document.get("forces") or []:
-        ends = split.moved_ends.get(force["name"], ())
-        if ends and "body" in force:
-            force["body"] = split.half
-        elif ends:
-            force["bodies"] = moved(force["bodies"], ends)
-    axis = np.subtract(split.far, split.near)
-    document["joints"].append({"name": split.guide, "type": "prismatic", "bodies": [split.body, split.half],
-                               "at": _point_text(split.near), "axis": (axis / np.linalg.norm(axis)).tolist()})
-    document["forces"] = (document.get("forces") or []) + [{
-        "type": "spring_damper", "name": split.spring, "bodies": [split.body, split.half],
-        "at": [_point_text(split.near), _point_text(split.far)], "stiffness": 0.0, "damping": 0.0,
-        "free_length": si_text(split.length, "length")}]
-
-
-def _point_text(point) -> list[str]:
-    return [si_text(coordinate, "length") for coordinate in point]
-
-
 def initial_tension(document: dict, split: LinkSplit, base_dir: Path) -> float:
     """The link's axial tension at t = 0 in the model as given: the split with its slide locked by a driver
     (the rigid link again), assembled, and the lock's multiplier at t = 0 (the force along the link on the
@@ -423,23 +298,19 @@ def initial_tension(document: dict, split: LinkSplit, base_dir: Path) -> float:
 
 def compliance(mechanism, document, base_dir: Path = Path(".")) -> list[Candidate]:
     """Axial stiffness k of each two-joint link: the link split in two halves along the line between
-    its joints, joined by a prismatic joint and a spring-damper k, c = ζ √(k m) (ζ = 2 %), whose free
+    its joints, joined by a prismatic joint and a spring-damper k, c = 2 ζ √(k m/4) (ζ = 2 %), whose free
     length L − T₀/k makes it carry the rigid link's tension T₀ at t = 0 (no start transient)."""
     out = []
-    for body, joints in _two_joint_links(mechanism):
+    for body, joints in two_joint_links(mechanism):
         split = link_split(mechanism, body, joints)
         if split is None:
             continue
         split = replace(split, tension=initial_tension(document, split, base_dir))
 
         def write(doc, value, split=split):
-            spring = next((f for f in doc.get("forces") or [] if f.get("name") == split.spring), None)
-            if spring is None:
+            if not any(f.get("name") == split.spring for f in doc.get("forces") or []):
                 split_link(doc, split)
-                spring = doc["forces"][-1]
-            spring["stiffness"] = si_text(value, "spring_stiffness")
-            spring["damping"] = si_text(COMPLIANCE_DAMPING_RATIO * np.sqrt(value * split.mass), "damping")
-            spring["free_length"] = si_text(split.length - split.tension / float(value), "length")
+            set_spring(doc, split, value, COMPLIANCE_DAMPING_RATIO)
 
         out.append(Candidate("compliance", body, "stiffness", "N/m", *COMPLIANCE_BOUNDS, True, None, write,
                              ("MN/m", 1e6), resonant=True))

@@ -22,6 +22,7 @@ from clearsim.units import (
     UNITS_CONTEXT,
     Acceleration,
     Angle,
+    Area,
     AngularSpeed,
     Damping,
     Force,
@@ -145,6 +146,27 @@ class Defaults(Strict):
 # --- bodies ---------------------------------------------------------------------------------------
 
 
+class AxialFlexibility(Strict):
+    """A two-joint link that stretches along the line between its joints (docs/model.md, flexible links)."""
+
+    model: Literal["axial"] = Field(description="axial: the link stretches along the line between its two joints")
+    youngs_modulus: Pressure | None = Field(None, gt=0.0, description="Young's modulus E of the link's material; k = E A / L")
+    area: Area | None = Field(None, gt=0.0, description="cross-section area A; k = E A / L (L: joint to joint at t = 0)")
+    axial_stiffness: SpringStiffness | None = Field(None, gt=0.0, description="axial stiffness k instead of E and A")
+    damping_ratio: float = Field(0.0, ge=0.0, lt=1.0, description="damping ratio ζ of the link's own axial mode: c = 2 ζ √(k m/4) (m: the link's mass)")
+    stiffness_damping: Time = Field(0.0, ge=0.0, description="Rayleigh stiffness-proportional damping β: c = β k added (ζ = β ω / 2 at ω)")
+
+    @model_validator(mode="after")
+    def _one_stiffness(self):
+        section = (self.youngs_modulus is not None, self.area is not None)
+        if self.axial_stiffness is None and not all(section):
+            missing = " and ".join(k for k, given in zip(("youngs_modulus", "area"), section) if not given)
+            raise ValueError(f"the axial stiffness needs the section: {missing} missing (or give axial_stiffness)")
+        if self.axial_stiffness is not None and any(section):
+            raise ValueError("give either axial_stiffness or youngs_modulus and area, not both")
+        return self
+
+
 class Body(Strict):
     name: str = Field(description="unique body name; `ground` is reserved")
     mass: Mass = Field(gt=0.0, description="mass m")
@@ -154,6 +176,7 @@ class Body(Strict):
     velocity: tuple[Speed, Speed] = Field((0.0, 0.0), description="centre-of-mass velocity at t = 0 (made consistent by assembly)")
     angular_velocity: AngularSpeed = Field(0.0, description="angular velocity at t = 0 (made consistent by assembly)")
     points: dict[str, Point] = Field(default_factory=dict, description="body-fixed points, body frame, from the centre of mass")
+    flexible: AxialFlexibility | None = Field(None, description="a compliant two-joint link; absent: rigid")
 
 
 # --- joints ---------------------------------------------------------------------------------------

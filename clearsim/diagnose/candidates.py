@@ -16,14 +16,7 @@ from typing import Callable
 
 import numpy as np
 
-from clearsim.assembly.build import BuildError
-from clearsim.assembly.arrays import for_kernels
-from clearsim.assembly.dynamics import accelerations, generalized_forces
-from clearsim.assembly.system import assemble
-from clearsim.diagnose.evaluate import document_text
-from clearsim.errors import ClearsimError
-from clearsim.model.flexible import LinkSplit, link_split, point_text, set_spring, split_link, two_joint_links
-from clearsim.model.loader import load_mechanism_text
+from clearsim.model.flexible import initial_tensions, link_split, point_text, set_spring, split_link, two_joint_links
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.resolve import is_clearance_joint, resolve_clearance
 from clearsim.model.schema import Mechanism, StrokeMotion
@@ -276,26 +269,6 @@ COMPLIANCE_BOUNDS = (1e6, 1e10)  # N/m: a soft composite pull rod (≈ 1 MN/m) t
 COMPLIANCE_DAMPING_RATIO = 0.02  # structural damping of the axial mode, 2 % of critical (bolted steel, GFRP: 1–5 %)
 
 
-def initial_tension(document: dict, split: LinkSplit, base_dir: Path) -> float:
-    """The link's axial tension at t = 0 in the model as given: the split with its slide locked by a driver
-    (the rigid link again), assembled, and the lock's multiplier at t = 0 (the force along the link on the
-    second half is −λ·axis, as a spring's tension λ). 0 when that model cannot be assembled."""
-    locked = copy.deepcopy(document)
-    split_link(locked, split)
-    lock = f"{split.guide}_lock"
-    locked["drivers"] = (locked.get("drivers") or []) + [
-        {"name": lock, "joint": split.guide, "motion": {"law": "polynomial", "coefficients": [0.0]}}]
-    try:
-        system = assemble(load_mechanism_text(document_text(locked), "compliance", (), base_dir).mechanism, base_dir)
-    except (BuildError, ClearsimError, ValueError):
-        return 0.0
-    free = np.zeros(len(system.clearance_joints), np.int64)  # every journal starts in free flight (mode FREE)
-    kernel_arrays = for_kernels(system.arrays)
-    forces = generalized_forces(kernel_arrays, 0.0, system.q0, system.qd0, free, np.zeros(free.size))[0]
-    multipliers = accelerations(kernel_arrays, 0.0, system.q0, system.qd0, forces, free)[1]
-    return float(multipliers[dict(system.drivers)[lock]])
-
-
 def compliance(mechanism, document, base_dir: Path = Path(".")) -> list[Candidate]:
     """Axial stiffness k of each two-joint link: the link split in two halves along the line between
     its joints, joined by a prismatic joint and a spring-damper k, c = 2 ζ √(k m/4) (ζ = 2 %), whose free
@@ -305,7 +278,7 @@ def compliance(mechanism, document, base_dir: Path = Path(".")) -> list[Candidat
         split = link_split(mechanism, body, joints)
         if split is None:
             continue
-        split = replace(split, tension=initial_tension(document, split, base_dir))
+        split = replace(split, tension=initial_tensions(document, [split], base_dir)[0])
 
         def write(doc, value, split=split):
             if not any(f.get("name") == split.spring for f in doc.get("forces") or []):

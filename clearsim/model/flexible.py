@@ -13,12 +13,12 @@ from __future__ import annotations
 
 import copy
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from clearsim.errors import Problem
-from clearsim.model.schema import PrismaticJoint, SpringDamper
+from clearsim.errors import ClearsimError, Problem
+from clearsim.model.schema import PrismaticJoint, SpringDamper, validate_mechanism
 from clearsim.units import si_text
 
 
@@ -199,16 +199,44 @@ def flexible_problems(mechanism) -> list[Problem]:
     return problems
 
 
-def expanded_document(document: dict, mechanism) -> dict:
-    """A copy of the document with every flexible body split (flexible_problems found none)."""
-    expanded = copy.deepcopy(document)
+def initial_tensions(document: dict, splits: list[LinkSplit], base_dir) -> list[float]:
+    """Each split link's axial tension at t = 0 in the model as given (N): the splits with their slides locked by
+    drivers (the rigid links again), assembled, and each lock's multiplier at t = 0 (the force along the link on
+    the second half is −λ·axis, as a spring's tension λ). 0 when that model cannot be assembled."""
+    from clearsim.assembly.arrays import for_kernels
+    from clearsim.assembly.build import BuildError
+    from clearsim.assembly.dynamics import accelerations, generalized_forces
+    from clearsim.assembly.system import assemble
+
+    locked = copy.deepcopy(document)
+    for split in splits:
+        split_link(locked, split)
+    locks = [f"{split.guide}_lock" for split in splits]
+    locked["drivers"] = (locked.get("drivers") or []) + [
+        {"name": lock, "joint": split.guide, "motion": {"law": "polynomial", "coefficients": [0.0]}}
+        for lock, split in zip(locks, splits)]
+    try:
+        system = assemble(validate_mechanism(locked), base_dir)
+    except (BuildError, ClearsimError, ValueError):
+        return [0.0] * len(splits)
+    free = np.zeros(len(system.clearance_joints), np.int64)  # every journal starts in free flight (mode FREE)
+    kernel_arrays = for_kernels(system.arrays)
+    forces = generalized_forces(kernel_arrays, 0.0, system.q0, system.qd0, free, np.zeros(free.size))[0]
+    multipliers = accelerations(kernel_arrays, 0.0, system.q0, system.qd0, forces, free)[1]
+    return [float(multipliers[dict(system.drivers)[lock]]) for lock in locks]
+
+
+def expanded_document(document: dict, mechanism, base_dir) -> dict:
+    """A copy of the document with every flexible body split, its spring carrying the rigid link's tension at
+    t = 0 (flexible_problems found none; `base_dir`: where the file's tables are)."""
     revolute, _ = joint_lists(mechanism)
-    for body in mechanism.bodies:
-        if body.flexible is None:
-            continue
-        split = link_split(mechanism, body.name, revolute[body.name])
+    flexible = [body for body in mechanism.bodies if body.flexible is not None]
+    splits = [link_split(mechanism, body.name, revolute[body.name]) for body in flexible]
+    tensions = initial_tensions(document, splits, base_dir)
+    expanded = copy.deepcopy(document)
+    for body, split, tension in zip(flexible, splits, tensions):
+        split = replace(split, tension=tension)
         split_link(expanded, split)
-        flexibility = body.flexible
-        set_spring(expanded, split, axial_stiffness(flexibility, split.length), flexibility.damping_ratio,
-                   flexibility.stiffness_damping)
+        set_spring(expanded, split, axial_stiffness(body.flexible, split.length), body.flexible.damping_ratio,
+                   body.flexible.stiffness_damping)
     return expanded

@@ -500,7 +500,8 @@ def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[s
         problems += check_references(mechanism) + duration_problems(mechanism)
         if not problems and any(body.flexible is not None for body in mechanism.bodies):
             problems += flexible_problems(mechanism)
-            mechanism = mechanism if problems else validate_mechanism(expanded_document(document, mechanism))
+            mechanism = mechanism if problems else validate_mechanism(
+                expanded_document(document, mechanism, base_dir or Path.cwd()))
     except ValidationError as exc:
         problems += validation_problems(exc, document, Mechanism) + _references_of_valid_part(document, exc)
     if problems:

@@ -38,7 +38,7 @@ joints:
   - {{name: O, type: revolute, bodies: [ground, link], at: O}}
   - {{name: A, type: revolute, bodies: [link, tip], at: A}}
 forces:
-  - {{type: constant, name: pull, body: tip, force: [PULL, 0]}}
+  - {{type: constant, name: push, body: tip, force: [0, 0]}}
 sensors:
   - {{name: stretch, type: point_displacement, body: tip, direction: [1, 0]}}
 solver: {{t_end: T_END, output_rate: 200 kHz, rtol: 1e-10, atol: 1e-13, max_step: 1e-4}}
@@ -47,10 +47,19 @@ OMEGA = np.sqrt(STIFFNESS / (TIP + LINK / 2))
 PERIOD = 2 * np.pi / OMEGA  # ≈ 14 ms
 
 
-def mass_on_link(zeta=0.0, velocity=0.0, pull=0.0, periods=100):
+def mass_on_link(zeta=0.0, velocity=0.0, periods=100):
     """The model; `zeta`: the damping ratio of the mass's oscillation, by Rayleigh's β = 2 ζ / ω."""
-    text = MASS_ON_LINK.replace("BETA", repr(float(2 * zeta / OMEGA))).replace("VELOCITY", repr(velocity)).replace("PULL", repr(pull))
+    text = MASS_ON_LINK.replace("BETA", repr(float(2 * zeta / OMEGA))).replace("VELOCITY", repr(velocity))
     return text.replace("T_END", repr(float(periods * PERIOD)))
+
+
+def with_pull_ramped_from_zero(text: str, folder, pull: float, on: str = "body: tip") -> str:
+    """The model with `push` replaced by a pull along x that rises from 0 to `pull` over the first 10 ms (the link
+    starts unloaded, so unstretched) and then stays."""
+    table = folder / "pull.csv"
+    table.write_text(f"time,force\n0,0\n0.01,{pull}\n")
+    return text.replace("{type: constant, name: push, body: tip, force: [0, 0]}",
+                        f"{{type: tabulated, name: pull, {on}, direction: [1, 0], file: '{table}'}}")
 
 
 def upward_crossings(t, x):
@@ -67,9 +76,9 @@ def test_a_mass_on_a_flexible_link_oscillates_at_the_square_root_of_k_over_m(sim
     assert measured == pytest.approx(OMEGA, rel=1e-3)
 
 
-def test_a_load_stretches_the_link_by_f_l_over_e_a(simulate):
+def test_a_load_stretches_the_link_by_f_l_over_e_a(simulate, tmp_path):
     pull = 1000.0  # N: 2.5 mm
-    result = simulate(mass_on_link(zeta=0.3, pull=pull, periods=40))
+    result = simulate(with_pull_ramped_from_zero(mass_on_link(zeta=0.3, periods=40), tmp_path, pull))
     settled = result["sensors/stretch"][-1]
     assert settled == pytest.approx(pull * LENGTH / (E * AREA), rel=1e-4)
 
@@ -121,13 +130,13 @@ def test_the_flexible_slider_crank_tends_to_the_rigid_one_as_the_rod_stiffens(si
     assert errors[1] < errors[0]  # converging
 
 
-def test_loads_and_sensors_on_the_links_own_points_follow_its_ends(simulate):
+def test_loads_and_sensors_on_the_links_own_points_follow_its_ends(simulate, tmp_path):
     """A pull on the link's own point A (its second joint) stretches it; a sensor there sees F L / (E A), one at
     its first joint O sees nothing."""
     pull = 1000.0
     text = mass_on_link(zeta=0.3, periods=40).replace(f"position: [{LENGTH / 2}, 0]\n",
                                                      f"position: [{LENGTH / 2}, 0]\n    points: {{O: [{-LENGTH / 2}, 0], A: [{LENGTH / 2}, 0]}}\n")
-    text = text.replace("body: tip, force: [0.0, 0]}", f"body: link, point: A, force: [{pull}, 0]}}")
+    text = with_pull_ramped_from_zero(text, tmp_path, pull, on="body: link, point: A")
     text = text.replace("  - {name: stretch, type: point_displacement, body: tip, direction: [1, 0]}",
                         "  - {name: stretch, type: point_displacement, body: link, point: A, direction: [1, 0]}\n"
                         "  - {name: root, type: point_displacement, body: link, point: O, direction: [1, 0]}")
@@ -160,7 +169,7 @@ def test_bad_flexible_input_is_refused_with_its_place(tmp_path, change, place, w
 
 
 def test_diagnose_compliance_candidate_is_the_same_element(tmp_path):
-    """The candidate writes the element's split and spring law; only its spring starts loaded (ℓ₀ = L − T₀/k)."""
+    """The candidate writes the element: the same split, spring law and initial tension."""
     loaded = load_mechanism(CONFIGS / "slider_crank_flores.yaml")
     document = yaml.safe_load(loaded.resolved_yaml)
     candidate = next(c for c in candidates_for(loaded.mechanism, document, ["compliance"], CONFIGS) if c.target == "rod")
@@ -168,8 +177,13 @@ def test_diagnose_compliance_candidate_is_the_same_element(tmp_path):
     declared = load_mechanism_text(flores_with_flexible_rod("{model: axial, axial_stiffness: 1e9 N/m, damping_ratio: 0.02}"))
     declared = declared.mechanism.model_dump()
     springs = [next(f for f in model["forces"] if f["name"] == "rod_compliance") for model in (fitted, declared)]
-    assert springs[1]["free_length"] == pytest.approx(0.12, rel=1e-12)  # unstretched at t = 0
-    assert springs[0]["free_length"] != springs[1]["free_length"]  # the candidate's carries the rod's tension T₀
-    for spring in springs:
-        del spring["free_length"]
-    assert fitted == declared
+    assert springs[0]["free_length"] < 0.12 - 1e-6  # ℓ₀ = L − T₀/k: the rod is compressed at t = 0 …
+    assert fitted == declared  # … in both
+
+
+def test_a_link_loaded_at_t0_starts_carrying_its_load(simulate):
+    """The positions in the file are those of t = 0 with the loads of t = 0 acting: the spring starts at the
+    rigid link's tension (ℓ₀ = L − T₀/k), so a link pulled from the start by 1 kN does not ring (unstretched at
+    t = 0 it would swing 5 mm peak to peak)."""
+    result = simulate(mass_on_link(periods=10).replace("force: [0, 0]}", "force: [1000.0, 0]}"))
+    assert np.max(np.abs(result["sensors/stretch"])) <= 1e-9

@@ -28,8 +28,10 @@ from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
 from clearsim.solver.outputs import (
     classify_episodes, chunk_outputs, full_precision, output_rate, sample_modes, stored_outputs,
 )
+from clearsim.solver.samples import C_ECC_X, C_ECC_Y
 from clearsim.solver.simulate import Chunk, Run, Statistics
 from clearsim.solver import precompile
+from clearsim.whirl import journal_paths, whirl_warnings
 
 BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
 # which per-sample histories a result file holds (its `contents` attribute, absent for "all"), each a subset of the
@@ -107,14 +109,14 @@ def _attributes(system: System, loaded: LoadedMechanism) -> dict:
             "output_rate_source": "derived" if system.mechanism.solver.output_rate is None else "solver.output_rate"}
 
 
-def _final_attributes(run: Run) -> dict:
+def _final_attributes(run: Run, warnings: list[str]) -> dict:
     stats = run.statistics()
     return {"wall_time_s": stats.wall_time, "kernel_time_s": stats.kernel_time,
             "kernels_compiled": stats.kernels_compiled, "steps": stats.steps, "rejected_steps": stats.rejected_steps,
             "rhs_evaluations": stats.rhs_evaluations, "contact_events": stats.contact_events,
             "max_step_violation": stats.max_violation, "simulated_time_s": run.time,
             "tolerance_over_penetration": stats.tolerance_over_penetration,
-            "peak_output_acceleration": stats.peak_output_acceleration, "warnings": "\n".join(run.warnings())}
+            "peak_output_acceleration": stats.peak_output_acceleration, "warnings": "\n".join(warnings)}
 
 
 def _write_episodes(writer: ResultWriter, system: System, run: Run, sample_episodes: np.ndarray) -> None:
@@ -186,10 +188,11 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                         error = write_failure(output, exc, needed)
                         status, complete = f"failed: {error}", False
                 # whatever failed above, the file is flagged as far as it can still be written
-                readable = writer.finish(complete, status, _final_attributes(run) if run is not None else {})
+                warnings = run.warnings() + pending.whirl_warnings() if run is not None else []
+                readable = writer.finish(complete, status, _final_attributes(run, warnings) if run is not None else {})
                 backup, identity, error = _give_its_name(writer, output, readable, error)
     return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
-                     run.warnings() if run is not None else [], identity)
+                     warnings, identity)
 
 
 def _give_its_name(writer: ResultWriter, output: Path, readable: bool, error: Exception | None):
@@ -257,6 +260,8 @@ class _PendingChunks:
         self.items: list = []
         self.initial_energy: float | None = None
         self.written_at = time.perf_counter()
+        self.times: list[np.ndarray] = []  # of the samples written, and their clearance joints' journal_paths
+        self.paths: list[np.ndarray] = []
 
     def add(self, chunk, run: Run) -> None:
         self.run = run  # its episode log classifies the modes at the flush
@@ -276,8 +281,17 @@ class _PendingChunks:
         with interrupts_deferred():  # the samples and their episodes are written whole, or not at all
             self.writer.append(chunk.times, outputs)
             self.episodes.append(chunk.episodes)
+            self.times.append(chunk.times)
+            self.paths.append(journal_paths(self.system.arrays.clearance_bodies, chunk.states,
+                                            chunk.contact[:, :, [C_ECC_X, C_ECC_Y]]))
         self.items.clear()
         self.written_at = time.perf_counter()
+
+    def whirl_warnings(self) -> list[str]:
+        """A warning per whirl of a clearance joint in the samples written (clearsim.whirl)."""
+        if not self.times:
+            return []
+        return whirl_warnings(self.system.clearance_joints, np.concatenate(self.times), np.concatenate(self.paths))
 
 
 def simulate_config(config: Path | str | None = None, overrides=(), output: Path | str = DEFAULT_OUTPUT,

@@ -46,5 +46,10 @@ def test_the_default_tolerances_resolve_every_contact_of_the_bundled_models(tmp_
     report = run(tmp_path, config, *overrides)
     assert report.statistics.contact_events > 0  # there were contacts to check
     assert 0.0 < report.statistics.tolerance_over_penetration < 3.0
-    assert report.warnings == []
-    assert summarize(report.output).warnings == []
+    assert solver_warnings(report.warnings) == []
+    assert solver_warnings(summarize(report.output).warnings) == []
+
+
+def solver_warnings(warnings: list[str]) -> list[str]:
+    """All but the whirl of a journal, a warning about the model (the UHV's J whirls: tests/validation/test_whirl.py)."""
+    return [line for line in warnings if "whirls around its bearing" not in line]

@@ -25,6 +25,7 @@ import yaml
 
 from clearsim.io.hdf5 import read_result
 from clearsim.sweep.figures import start_time
+from clearsim.whirl import orbit_angle, orbit_rate
 
 ROOT = Path(__file__).resolve().parents[2]
 CONFIG = ROOT / "configs" / "uhv_breaker.yaml"
@@ -203,7 +204,7 @@ def whirl(data, joint="J", window=WHIRL_WINDOW):
     inside = (t >= window[0]) & (t <= window[1])
     e = data[f"joints/{joint}/eccentricity"][inside]
     eccentricity = np.hypot(e[:, 0], e[:, 1])
-    angle = np.unwrap(np.arctan2(e[:, 1], e[:, 0]))
+    angle = orbit_angle(e)  # global, as the rolling rate: ė·t = ω_B R_B − ω_J R_J
     contact = data[f"joints/{joint}/mode"][inside] != 0
     surface_speed = (data[f"bodies/{bearing}/qd"][inside, 2] * radius
                      - data[f"bodies/{journal}/qd"][inside, 2] * (radius - clearance))  # ω_B R_B − ω_J R_J
@@ -221,7 +222,7 @@ def onset_angles(data, joint):
     bearing body's frame (0° = its x axis; for J, the upper linking board's direction I → J, so 180° faces I)."""
     bearing = joint_bodies(data, joint)[0]
     e = data[f"joints/{joint}/eccentricity"]
-    angle = np.unwrap(np.arctan2(e[:, 1], e[:, 0])) - data[f"bodies/{bearing}/q"][:, 2]
+    angle = orbit_angle(e, data[f"bodies/{bearing}/q"][:, 2])
     onsets = np.asarray(data[f"joints/{joint}/episodes/onset"])
     return np.degrees(np.interp(onsets, data["time"], angle)) % 360.0
 
@@ -438,9 +439,7 @@ def print_whirl_details(studies):
     bearing, _, _, clearance = joint_bodies(data, "J")
     t, omega = data["time"], data[f"bodies/{bearing}/qd"][:, 2]
     reversal = t[1:][(np.diff(np.sign(omega)) != 0) & (t[1:] > 0.005) & (t[1:] < 0.08)][0]
-    e = data["joints/J/eccentricity"]
-    rate = np.convolve(np.gradient(np.unwrap(np.arctan2(e[:, 1], e[:, 0])), t) / (2 * np.pi), np.ones(100) / 100,
-                       mode="same")  # 1 ms running mean, as in the whirl figure
+    rate = orbit_rate(t, orbit_angle(data["joints/J/eccentricity"]))  # 1 ms running mean, as in the whirl figure
     locked = t[(np.abs(rate) > 1000.0) & (t > reversal)][0]
     window = (t >= 0.055) & (t <= 0.065)
     print(f"\n(A and J, 0.01 mm: the {bearing.replace('_', ' ')} turns at up to {np.max(np.abs(omega)):.1f} rad/s and "
@@ -604,10 +603,8 @@ def whirl_figure(studies):
     for label, row in cases:
         data = result(row)
         bearing, journal, radius, clearance = joint_bodies(data, "J")
-        e = data["joints/J/eccentricity"]
         t = data["time"]
-        rate = np.gradient(np.unwrap(np.arctan2(e[:, 1], e[:, 0])), t) / (2 * np.pi)
-        smooth = np.convolve(rate, np.ones(100) / 100, mode="same")  # 1 ms running mean
+        smooth = orbit_rate(t, orbit_angle(data["joints/J/eccentricity"]))  # 1 ms running mean
         ax.plot(t * 1e3, smooth, lw=1.0, label=f"orbit rate, {label}")
     data = result(cases[0][1])
     bearing, journal, radius, clearance = joint_bodies(data, "J")

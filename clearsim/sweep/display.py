@@ -163,7 +163,7 @@ def closing_lines(result: SweepResult) -> list[str]:
         lines.append(f"percentiles over the samples → {result.summary.with_name('percentiles.csv')}")
     warned = [row["case"] for row in result.rows if row.get("warnings")]
     if warned:
-        lines.append(f"warning: {_cases(len(warned))} with results the solver could not vouch for ({', '.join(warned)}): "
+        lines.append(f"warning: {_cases(len(warned))} with warnings ({', '.join(warned)}): "
                      f"see the warnings column of {result.summary}")
     if result.interrupted:
         lines.append(f"interrupted: {len(finished)} of {total} cases finished; run the same command again to resume")

@@ -1,6 +1,7 @@
 """The whirl warning on the bundled models: the journal of J whirls on the UHV breaker with A and J at 0.01 mm
 (docs/validation.md §6); the rattling pin of the Flores slider-crank does not."""
 
+import csv
 import re
 from pathlib import Path
 
@@ -63,3 +64,15 @@ def test_the_rattling_pin_of_the_flores_slider_crank_does_not_whirl(tmp_path):
     under the criterion's 10)."""
     report, _ = run(tmp_path, FLORES, "solver.t_end=120ms")
     assert not whirl_lines(report.warnings), report.warnings
+
+
+def test_a_sweep_lists_the_whirl_in_its_warnings_column(tmp_path):
+    """A and J at 0.05 mm: J whirls (≈ 16 orbits at ≈ 540 Hz); the ideal case does not."""
+    out = tmp_path / "sweep"
+    printed = CliRunner().invoke(app, ["sweep", "--clearance", "0.05", "--joints", "A,J", "--workers", "1", "-o", str(out)])
+    assert printed.exit_code == 0, printed.output
+    with open(out / "summary.csv", newline="") as handle:
+        rows = {row["case"]: row["warnings"] for row in csv.DictReader(handle)}
+    assert rows["ideal"] == ""
+    assert [m.group(1) for m in whirl_lines(rows["clearance-0.05_mm"].split("\n"))] == ["J"], rows
+    assert "warning: 1 case with warnings (clearance-0.05_mm)" in printed.output

@@ -16,6 +16,7 @@ from typing import Callable
 
 import numpy as np
 
+from clearsim.assembly.arrays import CL_CLEARANCE
 from clearsim.assembly.build import BuildError
 from clearsim.assembly.system import System, assemble
 from clearsim.errors import ClearsimError, InputError, SolverError, format_path
@@ -282,8 +283,9 @@ class _PendingChunks:
             self.writer.append(chunk.times, outputs)
             self.episodes.append(chunk.episodes)
             self.times.append(chunk.times)
-            self.paths.append(journal_paths(self.system.arrays.clearance_bodies, chunk.states,
-                                            chunk.contact[:, :, [C_ECC_X, C_ECC_Y]]))
+            arrays = self.system.arrays
+            self.paths.append(journal_paths(arrays.clearance_bodies, arrays.clearance_params[:, CL_CLEARANCE],
+                                            chunk.states, chunk.contact[:, :, [C_ECC_X, C_ECC_Y]]))
         self.items.clear()
         self.written_at = time.perf_counter()
 

@@ -6,8 +6,9 @@ round at about the links' relative rotation (one orbit per relative turn at most
 orbits at (ω_B R_B − ω_J R_J)/|e|, R/c times faster (R/c = 5000 at 0.01 mm on a 50 mm pin), so a few degrees of
 relative rotation become many orbits. A rigid chain lets this go on undamped (docs/model.md, "Whirl").
 
-A *whirl* (whirl_windows) is a run of at least MIN_ORBITS consecutive full turns of φ in one direction, with at
-least AMPLIFICATION times as many orbits as the two bodies turn against each other meanwhile.
+A *whirl* (whirl_windows) is a run of at least MIN_ORBITS consecutive full turns of φ in one direction, at a
+sustained rate (SLOW_TURN), along the bearing wall (AT_WALL), with at least AMPLIFICATION times as many orbits as the
+two bodies turn against each other meanwhile.
 """
 
 from __future__ import annotations
@@ -21,6 +22,8 @@ MIN_ORBITS = 5  # full turns in one direction: a journal rattling between impact
 AMPLIFICATION = 10.0  # orbits per turn of the bodies' relative rotation: a journal carried by its load makes ≈ 1
 SLOW_TURN = 3.0  # a turn that takes longer than 3× the median turn of its run ends the whirl (or precedes it): the
 # journal drifting round before the whirl locks on, or after it stops, is not orbiting at a sustained rate
+AT_WALL = 0.5  # median |e|/c over the window at least: the journal runs along the wall (the UHV's J: 0.9–1.5), not
+# round the bearing's centre, where the angle of a small e wanders at random
 RATE_WINDOW = 1e-3  # s: the running mean of the orbit rate (orbit_rate), ≈ 2 orbits of the UHV's whirl of J
 HINT = "model the links' compliance; docs/model.md §5, \"Whirl\""
 
@@ -80,16 +83,17 @@ def full_turns(angle: np.ndarray) -> Turns:
     return Turns(np.asarray(starts, dtype=int), np.asarray(ends, dtype=int), np.asarray(directions, dtype=int))
 
 
-def whirl_windows(time: np.ndarray, angle: np.ndarray, relative_angle: np.ndarray,
+def whirl_windows(time: np.ndarray, angle: np.ndarray, relative_angle: np.ndarray, eccentricity_ratio: np.ndarray,
                   min_orbits: int = MIN_ORBITS, amplification: float = AMPLIFICATION) -> list[Whirl]:
-    """The whirls in a journal path: φ (orbit_angle) and the relative rotation θ_journal − θ_bearing (rad), per
-    sample at `time` (s)."""
+    """The whirls in a journal path: φ (orbit_angle), the relative rotation θ_journal − θ_bearing (rad) and |e|/c,
+    per sample at `time` (s)."""
     turns = full_turns(angle)
     whirls = []
     for run in _sustained_runs(time, turns):
         first, last = turns.starts[run[0]], turns.ends[run[-1]]
         relative = float(np.sum(np.abs(np.diff(relative_angle[first:last + 1])))) / (2 * np.pi)
-        if len(run) >= min_orbits and len(run) >= amplification * relative:
+        at_wall = np.median(eccentricity_ratio[first:last + 1]) >= AT_WALL
+        if len(run) >= min_orbits and len(run) >= amplification * relative and at_wall:
             whirls.append(Whirl(float(time[first]), float(time[last]), int(turns.directions[run[0]]) * len(run),
                                 relative))
     return whirls
@@ -120,19 +124,21 @@ def _hertz(frequency: float) -> str:
     return f"{frequency / 1e3:.2g} kHz" if frequency >= 1e3 else f"{frequency:.3g} Hz"
 
 
-def journal_paths(clearance_bodies: np.ndarray, states: np.ndarray, eccentricity: np.ndarray) -> np.ndarray:
-    """(S, joints, 2) per sample and clearance joint: the angle of e in the bearing body's frame, not unwrapped, and
-    θ_journal − θ_bearing (rad), from the bodies (bearing, journal) of each joint (−1: the ground, θ = 0), the
-    states (q first) and e (S, joints, 2, global)."""
+def journal_paths(clearance_bodies: np.ndarray, clearances: np.ndarray, states: np.ndarray,
+                  eccentricity: np.ndarray) -> np.ndarray:
+    """(S, joints, 3) per sample and clearance joint: the angle of e in the bearing body's frame, not unwrapped,
+    θ_journal − θ_bearing (rad), and |e|/c, from the bodies (bearing, journal) of each joint (−1: the ground, θ = 0),
+    its clearance c (m), the states (q first) and e (S, joints, 2, global)."""
     def body_angles(bodies: np.ndarray) -> np.ndarray:  # (S, joints)
         return np.column_stack([states[:, 3 * body + 2] if body >= 0 else np.zeros(len(states)) for body in bodies]
                                or [np.zeros((len(states), 0))])
 
     bearing, journal = body_angles(clearance_bodies[:, 0]), body_angles(clearance_bodies[:, 1])
-    return np.stack([np.arctan2(eccentricity[..., 1], eccentricity[..., 0]) - bearing, journal - bearing], axis=2)
+    return np.stack([np.arctan2(eccentricity[..., 1], eccentricity[..., 0]) - bearing, journal - bearing,
+                     np.hypot(eccentricity[..., 0], eccentricity[..., 1]) / clearances], axis=2)
 
 
 def whirl_warnings(joints: list[str], time: np.ndarray, paths: np.ndarray) -> list[str]:
     """A warning per whirl of each clearance joint, from its journal_paths."""
     return [whirl_warning(joint, whirl) for k, joint in enumerate(joints)
-            for whirl in whirl_windows(time, np.unwrap(paths[:, k, 0]), paths[:, k, 1])]
+            for whirl in whirl_windows(time, np.unwrap(paths[:, k, 0]), paths[:, k, 1], paths[:, k, 2])]

@@ -17,12 +17,19 @@ def path(angle: np.ndarray, radius: float = 1.4 * CLEARANCE, noise: float = 0.0,
     return e + noise * radius * rng.standard_normal(e.shape)
 
 
+def whirls_of(t: np.ndarray, e: np.ndarray, relative: np.ndarray | None = None):
+    """whirl_windows of a journal path e (S, 2) in a bearing that does not turn."""
+    relative = np.zeros_like(t) if relative is None else relative
+    return whirl_windows(t, orbit_angle(e), relative, np.hypot(e[:, 0], e[:, 1]) / CLEARANCE)
+
+
 def test_a_steady_orbit_of_k_turns_with_noise_is_one_whirl_of_k_orbits():
     k, frequency, begin = 12, 2000.0, 0.010  # turns, Hz, s
     t = np.arange(0.0, 0.030, 1.0 / RATE)
     angle = -2 * np.pi * frequency * np.clip(t - begin, 0.0, k / frequency)  # still, k turns backward, still
-    phi = orbit_angle(path(angle, noise=0.05))
-    whirls = whirl_windows(t, phi, np.zeros_like(t))
+    e = path(angle, noise=0.05)
+    phi = orbit_angle(e)
+    whirls = whirls_of(t, e)
     assert len(whirls) == 1, whirls
     assert whirls[0].orbits == -k
     assert whirls[0].start == pytest.approx(begin, abs=2e-5)
@@ -38,13 +45,13 @@ def test_the_orbit_angle_is_taken_in_the_bearing_s_frame():
     spin = 2 * np.pi * 2000.0 * t  # 20 turns of the bearing body
     phi = orbit_angle(path(spin + 0.3), spin)
     assert np.ptp(phi) < 1e-9
-    assert whirl_windows(t, orbit_angle(path(spin + 0.3)), np.zeros_like(t))  # in the global frame: 20 turns
+    assert whirls_of(t, path(spin + 0.3))  # in the global frame: 20 turns
 
 
 def test_fewer_than_the_minimum_orbits_are_not_a_whirl():
     t = np.arange(0.0, 0.010, 1.0 / RATE)
     angle = 2 * np.pi * 2000.0 * np.clip(t - 0.001, 0.0, (MIN_ORBITS - 0.5) / 2000.0)
-    assert whirl_windows(t, orbit_angle(path(angle)), np.zeros_like(t)) == []
+    assert whirls_of(t, path(angle)) == []
 
 
 def test_a_rattling_journal_does_not_whirl():
@@ -53,7 +60,7 @@ def test_a_rattling_journal_does_not_whirl():
     t = np.arange(0.0, 0.200, 1.0 / RATE)
     places = rng.uniform(-np.pi, np.pi, 200)  # a new side of the bore every ms
     angle = np.repeat(places, len(t) // len(places))
-    assert whirl_windows(t, orbit_angle(path(angle, noise=0.05)), np.zeros_like(t)) == []
+    assert whirls_of(t, path(angle, noise=0.05)) == []
 
 
 def test_a_journal_carried_round_by_its_load_does_not_whirl():
@@ -61,17 +68,27 @@ def test_a_journal_carried_round_by_its_load_does_not_whirl():
     the same orbit with a twentieth of that relative rotation is."""
     t = np.arange(0.0, 0.125, 1.0 / RATE)
     relative = 2 * np.pi * 5000.0 / 60.0 * t  # 5000 rpm: 10.4 turns
-    phi = orbit_angle(path(relative))
-    assert whirl_windows(t, phi, relative) == []
-    assert [w.orbits for w in whirl_windows(t, phi, relative / 20)] == [10]
+    assert whirls_of(t, path(relative), relative) == []
+    assert [w.orbits for w in whirls_of(t, path(relative), relative / 20)] == [10]
+
+
+def test_a_journal_wandering_round_the_bearing_centre_does_not_whirl():
+    """Near the centre the angle of a small e wanders at random and its turns can line up; along the wall the same
+    angles would be a whirl."""
+    t = np.arange(0.0, 0.200, 1.0 / RATE)
+    angle = np.cumsum(np.random.default_rng(2).normal(0.0, 0.3, len(t)))
+    assert whirls_of(t, path(angle, radius=0.05 * CLEARANCE)) == []
+    assert whirls_of(t, path(angle))
 
 
 def test_journal_paths_take_the_angles_of_the_bearing_and_journal_bodies_and_zero_for_the_ground():
     states = np.array([[0.0, 0.0, 0.5, 1.0, 2.0, 0.25], [0.0, 0.0, 0.75, 1.0, 2.0, 1.5]])  # q of two bodies, (x, y, θ)
     e = np.array([[[1.0, 0.0], [0.0, 1.0]], [[0.0, 1.0], [-1.0, 0.0]]])  # (S, joints, 2)
-    paths = journal_paths(np.array([[0, 1], [-1, 0]]), states, e)  # bearing 0, journal 1; bearing ground, journal 0
+    clearances = np.array([0.5, 2.0])
+    paths = journal_paths(np.array([[0, 1], [-1, 0]]), clearances, states, e)  # bearing 0, journal 1; ground, 0
     assert paths[:, 0, 0] == pytest.approx([0.0 - 0.5, np.pi / 2 - 0.75])
     assert paths[:, 0, 1] == pytest.approx([0.25 - 0.5, 1.5 - 0.75])
     assert paths[:, 1, 0] == pytest.approx([np.pi / 2, np.pi])
     assert paths[:, 1, 1] == pytest.approx([0.5, 0.75])
-    assert journal_paths(np.zeros((0, 2), int), states, np.zeros((2, 0, 2))).shape == (2, 0, 2)
+    assert paths[:, :, 2].ravel() == pytest.approx([2.0, 0.5, 2.0, 0.5])  # |e|/c
+    assert journal_paths(np.zeros((0, 2), int), np.zeros(0), states, np.zeros((2, 0, 2))).shape == (2, 0, 3)

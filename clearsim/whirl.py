@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 MIN_ORBITS = 5  # full turns in one direction: a journal rattling between impacts crosses the bore at random, its
-# orbit angle goes back and forth and does not make 5 turns in a row; noise of e in free flight neither
+# orbit angle goes back and forth and does not make 5 turns in a row
 AMPLIFICATION = 10.0  # orbits per turn of the bodies' relative rotation: a journal carried by its load makes ≈ 1
 SLOW_TURN = 3.0  # a turn that takes longer than 3× the median turn of its run ends the whirl (or precedes it): the
 # journal drifting round before the whirl locks on, or after it stops, is not orbiting at a sustained rate

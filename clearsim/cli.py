@@ -226,6 +226,8 @@ def run(
     console.print(written_line(report.output), highlight=False, soft_wrap=True)
     summary = summarize(report.output)
     console.print(_summary_table(report, summary))
+    for line in summary.flexible_modes:
+        console.print(line, highlight=False, soft_wrap=True)
     for warning in summary.warnings:
         if warning not in warned:
             _warning(warning)

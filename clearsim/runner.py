@@ -26,13 +26,14 @@ from clearsim.io.hdf5 import (
     result_overview, write_failure,
 )
 from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
+from clearsim.model.modes import flexible_link_names, flexible_modes_attribute, mode_lines
 from clearsim.solver.outputs import (
     classify_episodes, chunk_outputs, full_precision, output_rate, sample_modes, stored_outputs,
 )
 from clearsim.solver.samples import C_ECC_X, C_ECC_Y
 from clearsim.solver.simulate import Chunk, Run, Statistics
 from clearsim.solver import precompile
-from clearsim.whirl import journal_paths, whirl_warnings
+from clearsim.whirl import joint_whirls, journal_paths, whirl_warnings
 
 BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
 # which per-sample histories a result file holds (its `contents` attribute, absent for "all"), each a subset of the
@@ -120,6 +121,15 @@ def _final_attributes(run: Run, warnings: list[str]) -> dict:
             "peak_output_acceleration": stats.peak_output_acceleration, "warnings": "\n".join(warnings)}
 
 
+def _mode_attributes(system: System, loaded: LoadedMechanism, run: Run, whirls: dict) -> dict:
+    """`flexible_modes`: the flexible links' axial modes and what they are near (clearsim.model.modes), when the file
+    has flexible links."""
+    links = flexible_link_names(loaded.document)
+    if not links:
+        return {}
+    return {"flexible_modes": flexible_modes_attribute(system, links, loaded.base_dir, run.episode_log(), whirls)}
+
+
 def _write_episodes(writer: ResultWriter, system: System, run: Run, sample_episodes: np.ndarray) -> None:
     """Episode tables per clearance joint and the final contact modes of every sample."""
     log = run.episode_log()
@@ -189,8 +199,11 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                         error = write_failure(output, exc, needed)
                         status, complete = f"failed: {error}", False
                 # whatever failed above, the file is flagged as far as it can still be written
-                warnings = run.warnings() + pending.whirl_warnings() if run is not None else []
-                readable = writer.finish(complete, status, _final_attributes(run, warnings) if run is not None else {})
+                whirls = pending.whirls()
+                warnings = run.warnings() + whirl_warnings(whirls) if run is not None else []
+                final = _final_attributes(run, warnings) | _mode_attributes(system, loaded, run, whirls) \
+                    if run is not None else {}
+                readable = writer.finish(complete, status, final)
                 backup, identity, error = _give_its_name(writer, output, readable, error)
     return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
                      warnings, identity)
@@ -289,11 +302,11 @@ class _PendingChunks:
         self.items.clear()
         self.written_at = time.perf_counter()
 
-    def whirl_warnings(self) -> list[str]:
-        """A warning per whirl of a clearance joint in the samples written (clearsim.whirl)."""
+    def whirls(self) -> dict[str, list]:
+        """The whirls of each clearance joint in the samples written (clearsim.whirl)."""
         if not self.times:
-            return []
-        return whirl_warnings(self.system.clearance_joints, np.concatenate(self.times), np.concatenate(self.paths))
+            return {}
+        return joint_whirls(self.system.clearance_joints, np.concatenate(self.times), np.concatenate(self.paths))
 
 
 def simulate_config(config: Path | str | None = None, overrides=(), output: Path | str = DEFAULT_OUTPUT,
@@ -311,6 +324,7 @@ class Summary:
     contact_time_share: dict[str, tuple[float, float, float]]
     sticking_share: dict[str, float]  # of the time in contact, per joint (files without /stick: absent)
     warnings: list[str] = field(default_factory=list)  # the file's `warnings` attribute, a line each
+    flexible_modes: list[str] = field(default_factory=list)  # a line per flexible link (clearsim.model.modes)
 
 
 SUMMARY_JOINT_DATASETS = ("/normal_force", "/mode", "/stick")
@@ -345,7 +359,8 @@ def summarize(path: Path, data: dict | None = None) -> Summary:
     sticking = {j: float(np.mean(data[f"joints/{j}/stick"][data[f"joints/{j}/mode"] > 0]))
                 for j in joints if f"joints/{j}/stick" in data and np.any(data[f"joints/{j}/mode"] > 0)}
     warnings = [line for line in str(data["attrs"].get("warnings", "")).split("\n") if line]
-    return Summary(peak["velocity"], peak["acceleration"], forces, shares, sticking, warnings)
+    modes = mode_lines(str(data["attrs"].get("flexible_modes", "")))
+    return Summary(peak["velocity"], peak["acceleration"], forces, shares, sticking, warnings, modes)
 
 
 def _finite(values: np.ndarray) -> np.ndarray:

@@ -138,7 +138,12 @@ def journal_paths(clearance_bodies: np.ndarray, clearances: np.ndarray, states: 
                      np.hypot(eccentricity[..., 0], eccentricity[..., 1]) / clearances], axis=2)
 
 
-def whirl_warnings(joints: list[str], time: np.ndarray, paths: np.ndarray) -> list[str]:
-    """A warning per whirl of each clearance joint, from its journal_paths."""
-    return [whirl_warning(joint, whirl) for k, joint in enumerate(joints)
-            for whirl in whirl_windows(time, np.unwrap(paths[:, k, 0]), paths[:, k, 1], paths[:, k, 2])]
+def joint_whirls(joints: list[str], time: np.ndarray, paths: np.ndarray) -> dict[str, list[Whirl]]:
+    """The whirls of each clearance joint, from its journal_paths."""
+    return {joint: whirl_windows(time, np.unwrap(paths[:, k, 0]), paths[:, k, 1], paths[:, k, 2])
+            for k, joint in enumerate(joints)}
+
+
+def whirl_warnings(whirls: dict[str, list[Whirl]]) -> list[str]:
+    """A warning per whirl of each clearance joint (joint_whirls)."""
+    return [whirl_warning(joint, whirl) for joint, found in whirls.items() for whirl in found]

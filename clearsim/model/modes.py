@@ -1,0 +1,177 @@
+"""Which axial modes of the flexible links lie near the contact frequencies (docs/model.md §9, "Modes near the
+contacts").
+
+Axial mode of a flexible link: f = √(k / m_eff) / 2π, k its `<body>_compliance` stiffness and 1/m_eff the mobility
+of its slide `<body>_stretch`: the stretch acceleration s̈ = gᵀ A g per unit pair of opposite forces along the link
+(g: the stretch's row, ṡ = gᵀ q̇; A: the constrained response M q̈ + Φ_qᵀ λ = Q, Φ_q q̈ = γ) in the model at t = 0,
+with every clearance joint closed (an ideal pin) and every other flexible link's slide held. With the link's spring
+the only stiffness this is the exact linear mode at t = 0; for the free link m_eff = m/4, for a link fixed at one end
+carrying a mass M at the other m_eff = M + m/2.
+
+Contact frequency of a clearance joint: 1/(2 t_c), t_c the Hertz contact duration of its contact episodes at their
+own impact speed and effective mass (their 5th–95th percentile range), or of an impact at 1 m/s with the reduced
+mass of its two bodies when it made no contact. Whirl frequency: the mean orbit rate of each of its whirls.
+
+A mode is *near* a frequency range [f₁, f₂] when it lies within a factor NEAR_FACTOR of it: f₁/√2 ≤ f ≤ √2 f₂.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+NEAR_FACTOR = math.sqrt(2.0)  # half an octave: a mode √2 above a forcing frequency transmits it with gain 1/(r² − 1)
+# ≤ 1 (the classical isolation limit), √2 below with gain 1/(1 − r²) ≤ 2; within the band it amplifies it
+CONTACT_PERCENTILES = (5.0, 95.0)  # the range of the contacts' frequencies: most contacts, not a stray one
+
+
+@dataclass(frozen=True)
+class JointFrequencies:
+    joint: str
+    contacts: tuple[float, float]  # Hz: lowest, highest 1/(2 t_c)
+    whirls: tuple[float, ...]  # Hz: the mean orbit rate of each whirl
+
+
+def near(mode: float, lowest: float, highest: float, factor: float = NEAR_FACTOR) -> bool:
+    """Whether a mode (Hz) lies within `factor` of the range [lowest, highest] (Hz)."""
+    return lowest / factor <= mode <= highest * factor
+
+
+def flexible_link_names(document: dict) -> list[str]:
+    """The bodies the file declares flexible, in file order."""
+    return [body["name"] for body in document.get("bodies") or [] if isinstance(body, dict) and body.get("flexible")]
+
+
+def _closed_clearances(mechanism):
+    """The mechanism with every clearance joint an ideal pin."""
+    joints = [joint.model_copy(update={"clearance": None, "journal_radius": None})
+              if getattr(joint, "clearance", None) or getattr(joint, "journal_radius", None) else joint
+              for joint in mechanism.joints]
+    return mechanism.model_copy(update={"joints": joints})
+
+
+def _stretch_row(body_names: list[str], q: np.ndarray, spring) -> np.ndarray:
+    """g with ṡ = gᵀ q̇: the rate at which the spring's two ends (global points at t = 0) part along their line."""
+    near_point, far_point = (np.asarray(point, dtype=float) for point in spring.at)
+    axis = (far_point - near_point) / np.linalg.norm(far_point - near_point)
+    row = np.zeros(q.size)
+    for body, point, sign in ((spring.bodies[0], near_point, -1.0), (spring.bodies[1], far_point, 1.0)):
+        index = body_names.index(body)
+        arm = point - q[3 * index:3 * index + 2]
+        row[3 * index:3 * index + 3] += sign * np.array([axis[0], axis[1], arm[0] * axis[1] - arm[1] * axis[0]])
+    return row
+
+
+def stretch_mobilities(system, springs: list) -> np.ndarray:
+    """C (L × L, 1/kg): stretch acceleration of each slide per unit pair of opposite forces along each link, in the
+    constrained system at its initial configuration, at rest."""
+    from clearsim.assembly.arrays import for_kernels
+    from clearsim.assembly.dynamics import accelerations
+
+    arrays = for_kernels(system.arrays)
+    modes = np.zeros(len(system.clearance_joints), np.int64)
+    rest = np.zeros(system.q0.size)
+    rows = np.array([_stretch_row(system.body_names, system.q0, spring) for spring in springs]).reshape(-1, rest.size)
+    baseline = accelerations(arrays, 0.0, system.q0, rest, rest.copy(), modes)[0]
+    responses = [accelerations(arrays, 0.0, system.q0, rest, row.copy(), modes)[0] - baseline for row in rows]
+    return rows @ np.array(responses).reshape(-1, rest.size).T
+
+
+def held_mobility(mobilities: np.ndarray, link: int) -> float:
+    """The link's own mobility with every other slide held: C_ii − C_io C_oo⁺ C_oi."""
+    others = [k for k in range(len(mobilities)) if k != link]
+    coupling = mobilities[link, others]
+    return float(mobilities[link, link] - coupling @ np.linalg.pinv(mobilities[np.ix_(others, others)]) @ coupling)
+
+
+def axial_mode_frequencies(mechanism, links: list[str], base_dir) -> dict[str, float]:
+    """Each flexible link's axial mode (Hz), as the module's docstring defines it; NaN for a link whose slide cannot
+    move with its clearance joints closed."""
+    from clearsim.assembly.system import assemble
+
+    system = assemble(_closed_clearances(mechanism), base_dir)
+    springs = [next(force for force in system.mechanism.forces if force.name == f"{link}_compliance") for link in links]
+    mobilities = stretch_mobilities(system, springs)
+    frequencies = {}
+    for k, (link, spring) in enumerate(zip(links, springs)):
+        mobility = held_mobility(mobilities, k)
+        frequencies[link] = math.sqrt(spring.stiffness * mobility) / (2 * math.pi) if mobility > 0 else math.nan
+    return frequencies
+
+
+def contact_frequencies(system, episodes) -> list[tuple[float, float]]:
+    """Per clearance joint, the range of 1/(2 t_c) over its contact episodes (CONTACT_PERCENTILES), or at the
+    reference impact when it had none (Hz)."""
+    from clearsim.solver.outputs import contact_durations, hertz_durations
+
+    durations = hertz_durations(system, episodes.joint, episodes.impact_speed, episodes.effective_mass)
+    reference = contact_durations(system)
+    ranges = []
+    for k in range(len(system.clearance_joints)):
+        frequencies = 1.0 / (2.0 * durations[episodes.joint == k])
+        if not len(frequencies):
+            frequencies = np.array([1.0 / (2.0 * reference[k])])
+        lowest, highest = np.percentile(frequencies, CONTACT_PERCENTILES)
+        ranges.append((float(lowest), float(highest)))
+    return ranges
+
+
+def mode_report(modes: dict[str, float], joints: list[JointFrequencies]) -> list[dict]:
+    """The `flexible_modes` attribute (as a list): per link its mode and what it is near."""
+    return [{"link": link, "axial_mode_hz": mode,
+             "near_contacts": [j.joint for j in joints if near(mode, *j.contacts)],
+             "near_whirls": [j.joint for j in joints if any(near(mode, w, w) for w in j.whirls)],
+             "contacts_hz": {j.joint: list(j.contacts) for j in joints},
+             "whirls_hz": {j.joint: list(j.whirls) for j in joints if j.whirls}}
+            for link, mode in modes.items()]
+
+
+def flexible_modes_attribute(system, links: list[str], base_dir, episodes, whirls: dict) -> str:
+    """The result file's `flexible_modes` (JSON, mode_report) of a run's system, its episode log and its joints'
+    whirls (clearsim.whirl.joint_whirls); a mode is NaN when the model with closed clearance joints does not
+    assemble."""
+    from clearsim.assembly.build import BuildError
+    from clearsim.errors import ClearsimError
+
+    try:
+        modes = axial_mode_frequencies(system.mechanism, links, base_dir)
+    except (BuildError, ClearsimError, ValueError, np.linalg.LinAlgError):
+        modes = dict.fromkeys(links, math.nan)
+    joints = [JointFrequencies(joint, contacts, tuple(whirl.frequency for whirl in whirls.get(joint, ())))
+              for joint, contacts in zip(system.clearance_joints, contact_frequencies(system, episodes))]
+    return json.dumps(mode_report(modes, joints))
+
+
+def hertz_text(frequency: float) -> str:
+    if not math.isfinite(frequency):
+        return "none"
+    return f"{frequency / 1e3:.2g} kHz" if frequency >= 1e3 else f"{frequency:.3g} Hz"
+
+
+def range_text(lowest: float, highest: float) -> str:
+    if hertz_text(lowest) == hertz_text(highest):
+        return hertz_text(lowest)
+    if lowest >= 1e3 and highest >= 1e3:
+        return f"{lowest / 1e3:.2g}–{highest / 1e3:.2g} kHz"
+    return f"{hertz_text(lowest)} – {hertz_text(highest)}"
+
+
+def mode_lines(attribute: str) -> list[str]:
+    """One line per flexible link from the `flexible_modes` attribute, e.g. "flexible link pole: axial mode 412 Hz,
+    near nothing (within √2); joint J: contacts 6–8 kHz, whirl 2.1 kHz"."""
+    lines = []
+    for entry in json.loads(attribute) if attribute else []:
+        nearby = [f"joint {j}'s contacts" for j in entry["near_contacts"]]
+        nearby += [f"joint {j}'s whirl" for j in entry["near_whirls"]]
+        joints = []
+        for joint, contacts in entry["contacts_hz"].items():
+            whirls = entry["whirls_hz"].get(joint, [])
+            joints.append(f"joint {joint}: contacts {range_text(*contacts)}"
+                          + "".join(f", whirl {hertz_text(w)}" for w in whirls))
+        head = (f"flexible link {entry['link']}: axial mode {hertz_text(entry['axial_mode_hz'])}, near "
+                f"{' and '.join(nearby) if nearby else 'no contact or whirl frequency'} (within ×√2)")
+        lines.append("; ".join([head] + joints))
+    return lines

@@ -115,12 +115,12 @@ def _sustained_runs(time: np.ndarray, turns: Turns) -> list[np.ndarray]:
 
 def whirl_warning(joint: str, whirl: Whirl) -> str:
     return (f"joint {joint}: the journal whirls around its bearing from {whirl.start * 1e3:.1f} to "
-            f"{whirl.end * 1e3:.1f} ms, {abs(whirl.orbits)} orbits ({_hertz(whirl.frequency)}) while its two bodies turn "
+            f"{whirl.end * 1e3:.1f} ms, {abs(whirl.orbits)} orbits ({hertz_text(whirl.frequency)}) while its two bodies turn "
             f"{whirl.relative_turns:.2g} turns against each other: it runs round the bore, an effect of the rigid links "
             f"that can set the run's peaks (hint: {HINT})")
 
 
-def _hertz(frequency: float) -> str:
+def hertz_text(frequency: float) -> str:
     return f"{frequency / 1e3:.2g} kHz" if frequency >= 1e3 else f"{frequency:.3g} Hz"
 
 

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from clearsim.whirl import hertz_text
+
 NEAR_FACTOR = math.sqrt(2.0)  # half an octave: a mode √2 above a forcing frequency transmits it with gain 1/(r² − 1)
 # ≤ 1 (the classical isolation limit), √2 below with gain 1/(1 − r²) ≤ 2; within the band it amplifies it
 CONTACT_PERCENTILES = (5.0, 95.0)  # the range of the contacts' frequencies: most contacts, not a stray one
@@ -145,18 +147,17 @@ def flexible_modes_attribute(system, links: list[str], base_dir, episodes, whirl
     return json.dumps(mode_report(modes, joints))
 
 
-def hertz_text(frequency: float) -> str:
-    if not math.isfinite(frequency):
-        return "none"
-    return f"{frequency / 1e3:.2g} kHz" if frequency >= 1e3 else f"{frequency:.3g} Hz"
+def frequency_text(frequency: float) -> str:
+    """As a whirl warning gives a frequency ("412 Hz", "2.1 kHz"); "none" for a mode the model could not give."""
+    return hertz_text(frequency) if math.isfinite(frequency) else "none"
 
 
 def range_text(lowest: float, highest: float) -> str:
-    if hertz_text(lowest) == hertz_text(highest):
-        return hertz_text(lowest)
+    if frequency_text(lowest) == frequency_text(highest):
+        return frequency_text(lowest)
     if lowest >= 1e3 and highest >= 1e3:
         return f"{lowest / 1e3:.2g}–{highest / 1e3:.2g} kHz"
-    return f"{hertz_text(lowest)} – {hertz_text(highest)}"
+    return f"{frequency_text(lowest)} – {frequency_text(highest)}"
 
 
 def mode_lines(attribute: str) -> list[str]:
@@ -170,8 +171,8 @@ def mode_lines(attribute: str) -> list[str]:
         for joint, contacts in entry["contacts_hz"].items():
             whirls = entry["whirls_hz"].get(joint, [])
             joints.append(f"joint {joint}: contacts {range_text(*contacts)}"
-                          + "".join(f", whirl {hertz_text(w)}" for w in whirls))
-        head = (f"flexible link {entry['link']}: axial mode {hertz_text(entry['axial_mode_hz'])}, near "
+                          + "".join(f", whirl {frequency_text(w)}" for w in whirls))
+        head = (f"flexible link {entry['link']}: axial mode {frequency_text(entry['axial_mode_hz'])}, near "
                 f"{' and '.join(nearby) if nearby else 'no contact or whirl frequency'} (within ×√2)")
         lines.append("; ".join([head] + joints))
     return lines

@@ -22,6 +22,7 @@ STIFFNESS_FACTOR = 1e3  # a contact stiffness this many times above or below the
 YOUNGS_MODULUS = (1e6, 1.2e12)  # Pa: rubber to diamond
 MAX_DRIVEN_SPEED = 40.0  # m/s: a racing engine's crank pin (18 000 rpm at 20 mm) moves at 38 m/s
 CENTRE_FACTOR = 2.0  # a centre of mass farther than this many body sizes from every joint of its body
+COINCIDENT = 1e-9  # of the mechanism's extent: joints closer than this are at one place
 
 
 def warning_text(problems: list[Problem], loaded) -> str:
@@ -183,14 +184,16 @@ def _centre_of_mass_warnings(mechanism, attached, sizes, extent: float) -> list[
     warnings = []
     for index, body in enumerate(mechanism.bodies):
         points, centre = attached.get(body.name, []), np.asarray(body.position, float)
-        scale = sizes.get(body.name) or extent
+        size = sizes.get(body.name, 0.0)
+        # joints at one place (a flexible link's half: its pin and its slide) span no size: the mechanism's is used
+        scale = size if size > COINCIDENT * extent else extent
         if not points or scale <= 0.0:
             continue
         distance = min(float(np.linalg.norm(p - centre)) for p in points)
         if distance > CENTRE_FACTOR * scale:
             warnings.append(Problem(("bodies", index, "position"), f"the centre of mass of '{body.name}' is "
                                     f"{_length(distance)} from its nearest joint, while "
-                                    f"{'its joints' if sizes.get(body.name) else 'the joints of the mechanism'} "
+                                    f"{'its joints' if scale == size else 'the joints of the mechanism'} "
                                     f"span {_length(scale)}",
                                     "check the unit of `position`, e.g. `position: [25 mm, 43.3 mm]`"))
     return warnings

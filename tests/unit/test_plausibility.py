@@ -37,6 +37,14 @@ def test_no_warning_on_the_bundled_models(config):
     assert plausibility_warnings(load_mechanism(config).mechanism) == []
 
 
+def test_a_flexible_link_gives_no_warning():
+    """Its halves each have their pin and the slide at one place: 'joints span 1.11e-13 mm' was a false alarm."""
+    rod = ("{name: rod, mass: 0.21 kg, inertia: 0.00025 kg*m^2, position: [0.11 m, 0 m]}",
+           "{name: rod, mass: 0.21 kg, inertia: 0.00025 kg*m^2, position: [0.11 m, 0 m], "
+           "flexible: {model: axial, axial_stiffness: 1e8 N/m, damping_ratio: 0.02}}")
+    assert warnings_of(edited(rod)) == ""
+
+
 def test_the_meant_values_of_the_issue_give_no_warning():
     assert warnings_of(edited(*LONG_CRANK, ("speed: 5000 rpm", "speed: 31.4"))) == ""  # 300 rpm
 

@@ -302,10 +302,13 @@ def validate(config: Optional[Path] = ConfigArgument, overrides: List[str] = Set
     _print_plausibility_warnings(loaded)
     system = prepare(loaded)
     mechanism = system.mechanism
-    console.print(f"{loaded.path}: OK — {len(mechanism.bodies)} bodies, {len(mechanism.joints)} joints, "
+    written = {key: loaded.document.get(key) or [] for key in ("bodies", "joints")}  # as in the file, not expanded
+    flexible = [body.get("name") for body in written["bodies"] if isinstance(body, dict) and "flexible" in body]
+    stretches = f", {len(flexible)} from flexible links: {', '.join(flexible)}" if flexible else ""
+    console.print(f"{loaded.path}: OK — {len(written['bodies'])} bodies, {len(written['joints'])} joints, "
                   f"{len(mechanism.drivers)} drivers, {system.degrees_of_freedom} degrees of freedom "
                   f"({2 * len(system.clearance_joints)} from clearance joints: "
-                  f"{', '.join(system.clearance_joints) or 'none'})")
+                  f"{', '.join(system.clearance_joints) or 'none'}{stretches})")
 
 
 @app.command()

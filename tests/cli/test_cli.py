@@ -84,6 +84,20 @@ def test_validate_and_schema(tmp_path):
     assert {"bodies", "joints", "solver"} <= set(schema["properties"])
 
 
+def test_validate_counts_the_file_s_bodies_and_names_the_flexible_links(tmp_path):
+    """A flexible link is two halves on a slide inside: validate said 4 bodies, 5 joints for this 3-body file."""
+    rod = "{name: rod, mass: 0.21 kg, inertia: 0.00025 kg*m^2, position: [0.11 m, 0 m]}"
+    text = Path(SLIDER_CRANK).read_text()
+    assert text.count(rod) == 1
+    path = tmp_path / "flexible.yaml"
+    path.write_text(text.replace(rod, rod[:-1] + ", flexible: {model: axial, axial_stiffness: 1e8 N/m}}"))
+    result = invoke("validate", str(path))
+    assert result.exit_code == 0, result.output
+    summary = " ".join(result.output.split())
+    assert "3 bodies, 4 joints, 1 drivers, 3 degrees of freedom" in summary
+    assert "(2 from clearance joints: slider_pin, 1 from flexible links: rod)" in summary
+
+
 REDUNDANT = """
 name: body pinned to the ground twice
 points: {O: [0 m, 0 m], P: [0.2 m, 0 m]}

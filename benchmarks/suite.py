@@ -23,7 +23,8 @@ from typing import Callable
 import numpy as np
 
 CONFIGS = Path(__file__).resolve().parents[1] / "clearsim" / "configs"
-UHV, CRANK, CRANK_FRICTION = CONFIGS / "uhv_breaker.yaml", CONFIGS / "slider_crank_flores.yaml", CONFIGS / "slider_crank_flores_friction.yaml"
+UHV, UHV_FLEXIBLE = CONFIGS / "uhv_breaker.yaml", CONFIGS / "uhv_breaker_flexible.yaml"
+CRANK, CRANK_FRICTION = CONFIGS / "slider_crank_flores.yaml", CONFIGS / "slider_crank_flores_friction.yaml"
 RESULTS = Path(__file__).resolve().parent / "results"
 TIGHTER = 100.0
 
@@ -40,6 +41,8 @@ CASES = [
     Case("uhv-ideal", UHV, ("joints.A.clearance=0", "joints.J.clearance=0")),
     Case("uhv-c0.01", UHV, (), ("solver.t_end=10ms",)),
     Case("uhv-c0.1", UHV, ("joints.A.clearance=0.1mm", "joints.J.clearance=0.1mm"), ("solver.t_end=10ms",)),
+    Case("uhv-flex-ideal", UHV_FLEXIBLE, ("joints.A.clearance=0", "joints.J.clearance=0")),
+    Case("uhv-flex-c0.01", UHV_FLEXIBLE, (), ("solver.t_end=10ms",)),
     Case("crank-frictionless", CRANK, (), ("solver.t_end=6ms",)),
     Case("crank-friction", CRANK_FRICTION, (), ("solver.t_end=6ms",)),
 ]

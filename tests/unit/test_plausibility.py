@@ -32,13 +32,7 @@ LONG_CRANK = [("A: [0.05 m, 0 m]", "A: [0.17 m, 0 m]"), ("B: [0.17 m, 0 m]", "B:
               ("inertia: 0.0001 kg*m^2, position: [0.17 m, 0 m]", "inertia: 0.0001 kg*m^2, position: [0.57 m, 0 m]")]
 
 
-# Known defect, to fix in clearsim/model/plausibility.py: the check reads the mechanism with its flexible links
-# expanded, where each half's joint and its `_stretch` guide sit at one point up to rounding (span ~1e-14 m).
-EXPANDED_HALVES = pytest.mark.xfail(strict=True, reason="plausibility reads the expanded flexible links")
-
-
-@pytest.mark.parametrize("config", [pytest.param(p, marks=EXPANDED_HALVES) if p.name == "uhv_breaker_flexible.yaml" else p
-                                    for p in sorted(CONFIGS.glob("*.yaml"))], ids=lambda p: p.name)
+@pytest.mark.parametrize("config", sorted(CONFIGS.glob("*.yaml")), ids=lambda p: p.name)
 def test_no_warning_on_the_bundled_models(config):
     assert plausibility_warnings(load_mechanism(config).mechanism) == []
 

@@ -162,10 +162,12 @@ def print_spread_vs_trend(figures):
     runs = [f for mu in MU_D for f in figures[mu]]
     times = np.array([f["t_peak_ms"] for f in runs])
     early = times < 2.0
+    def span(selected: np.ndarray) -> str:
+        return f"t = {selected.min():.2f} … {selected.max():.2f} ms" if selected.size else "none"
+
     print(f"\n(the peak over the stroke is the peak of the first 10 ms in {sum(f['peak'] == f['peak_10ms'] for f in runs)} "
-          f"of the {len(runs)} runs; it is the slack take-up impact, t = {times[early].min():.2f} … "
-          f"{times[early].max():.2f} ms, in {early.sum()} runs, a later impact (t = {times[~early].min():.2f} … "
-          f"{times[~early].max():.2f} ms) in the others)")
+          f"of the {len(runs)} runs; it is the slack take-up impact ({span(times[early])}) in {early.sum()} runs, a "
+          f"later impact ({span(times[~early])}) in the others)")
     print(f"\n(peak |a| over the stroke: the sample spread at μ_d = 0.10 is {spread:.0f} % (std/mean); one unrelated "
           f"draw per μ_d shows a lower peak at 0.16 in {falls:.0f} % of the pairings, the same draw in {paired:.0f} % "
           f"of the samples, by at most {-np.min(after / before - 1) * 100:.1f} %; the paper's fall is {(PAPER['friction']['0.16']['peak_acceleration_m_s2'] / PAPER['friction']['0.10']['peak_acceleration_m_s2'] - 1) * 100:.1f} %)")

@@ -96,7 +96,7 @@ class Material(Strict):
 class ContactSpec(Strict):
     """Normal contact law F = K δⁿ (1 + D(c_e) δ̇/δ̇⁻); every field optional at joint level."""
 
-    law: Literal["lankarani_nikravesh", "hertz", "hunt_crossley", "flores"] | None = Field(None, description="contact force law (docs/model.md §3)")
+    law: Literal["lankarani_nikravesh", "hertz", "hunt_crossley", "flores", "gonthier"] | None = Field(None, description="contact force law (docs/model.md §3)")
     restitution: float | None = Field(None, gt=0.0, le=1.0, description="coefficient of restitution c_e, 0 < c_e <= 1")
     exponent: float | None = Field(None, gt=0.0, le=3.0, description="force exponent n (1.5 for metals)")
     stiffness: Annotated[RawQuantity, _needs_unit("force", ("N/m^1.5", "N/mm^1.5"), "{length: mm, force: N}")] | None = Field(

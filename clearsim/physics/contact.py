@@ -20,12 +20,14 @@ HERTZ = 0
 LANKARANI_NIKRAVESH = 1
 HUNT_CROSSLEY = 2
 FLORES = 3
+GONTHIER = 4
 
 CONTACT_LAWS = {
     "hertz": HERTZ,
     "lankarani_nikravesh": LANKARANI_NIKRAVESH,
     "hunt_crossley": HUNT_CROSSLEY,
     "flores": FLORES,
+    "gonthier": GONTHIER,
 }
 
 # ∫₀¹ dx / sqrt(1 − x^{5/2}) = (2/5) B(2/5, 1/2) ≈ 1.47164 (substitute u = x^{5/2});
@@ -36,13 +38,16 @@ _HERTZ_HALF_TIME_INTEGRAL = 0.4 * math.gamma(0.4) * math.gamma(0.5) / math.gamma
 @njit(cache=True, inline="always")
 def hysteresis_factor(law, restitution):
     """D(c_e): 0 (Hertz), 3(1−c_e²)/4 (Lankarani–Nikravesh 1990, Meng 2015 eq. 11),
-    3(1−c_e)/2 (Hunt–Crossley 1975), 8(1−c_e)/(5c_e) (Flores et al. 2011)."""
+    3(1−c_e)/2 (Hunt–Crossley 1975), 8(1−c_e)/(5c_e) (Flores et al. 2011),
+    (1−c_e²)/c_e (Gonthier, McPhee, Lange, Piedbœuf 2004)."""
     if law == LANKARANI_NIKRAVESH:
         return 0.75 * (1.0 - restitution * restitution)
     if law == HUNT_CROSSLEY:
         return 1.5 * (1.0 - restitution)
     if law == FLORES:
         return 1.6 * (1.0 - restitution) / restitution
+    if law == GONTHIER:
+        return (1.0 - restitution * restitution) / restitution
     return 0.0
 
 

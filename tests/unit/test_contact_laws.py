@@ -9,6 +9,7 @@ from scipy.optimize import brentq
 from clearsim.physics.contact import (
     CONTACT_LAWS,
     FLORES,
+    GONTHIER,
     HERTZ,
     HUNT_CROSSLEY,
     LANKARANI_NIKRAVESH,
@@ -23,7 +24,7 @@ from clearsim.physics.contact import (
 )
 from tests.support.impact_reference import law_impact
 
-DAMPED_LAWS = (LANKARANI_NIKRAVESH, HUNT_CROSSLEY, FLORES)
+DAMPED_LAWS = (LANKARANI_NIKRAVESH, HUNT_CROSSLEY, FLORES, GONTHIER)
 ALL_LAWS = (HERTZ,) + DAMPED_LAWS
 STEEL_E, STEEL_NU = 207e9, 0.3  # Pa, -
 
@@ -36,11 +37,13 @@ HAND_FORCES = {
     LANKARANI_NIKRAVESH: ELASTIC * (1.0 + 0.75 * 0.36 * 0.4),  # D = 3(1 − 0.64)/4 = 0.27
     HUNT_CROSSLEY: ELASTIC * (1.0 + 1.5 * 0.2 * 0.4),  # D = 3(0.2)/2 = 0.3
     FLORES: ELASTIC * (1.0 + 8.0 * 0.2 / 4.0 * 0.4),  # D = 8(0.2)/(5·0.8) = 0.4
+    GONTHIER: ELASTIC * (1.0 + 0.45 * 0.4),  # D = (1 − 0.64)/0.8 = 0.45
 }
 
 
 def test_law_codes_are_distinct_and_named():
-    assert CONTACT_LAWS == {"hertz": 0, "lankarani_nikravesh": 1, "hunt_crossley": 2, "flores": 3}
+    assert CONTACT_LAWS == {"hertz": 0, "lankarani_nikravesh": 1, "hunt_crossley": 2, "flores": 3,
+                            "gonthier": 4}
 
 
 @pytest.mark.parametrize("law", ALL_LAWS)
@@ -163,6 +166,20 @@ def test_lankarani_nikravesh_is_inaccurate_for_plastic_impacts():
 @pytest.mark.parametrize("restitution", [0.5, 0.7, 0.9, 0.99])
 def test_flores_is_close_to_nominal_over_a_wide_range(restitution):
     assert abs(law_impact(FLORES, restitution).restitution - restitution) < 0.035
+
+
+# Gonthier: 0.1 → 0.1010, 0.3 → 0.3042, 0.5 → 0.4877, 0.9 → 0.8764, 0.99 → 0.9868.
+@pytest.mark.parametrize("restitution", [0.1, 0.3, 0.5])
+def test_gonthier_is_accurate_for_plastic_impacts(restitution):
+    assert abs(law_impact(GONTHIER, restitution).restitution - restitution) < 0.013
+
+
+@pytest.mark.parametrize("restitution", [0.99, 0.999])
+def test_gonthier_over_dissipates_near_elastic_by_four_thirds(restitution):
+    # Near c_e = 1, D = (1 − c_e²)/c_e ≈ 2(1 − c_e) is 4/3 of the Hunt–Crossley D = 3(1 − c_e)/2,
+    # whose first-order loss matches c_e exactly: the effective 1 − c_e is 4/3 of the nominal one.
+    effective = law_impact(GONTHIER, restitution).restitution
+    assert (1.0 - effective) / (1.0 - restitution) == pytest.approx(4.0 / 3.0, rel=0.02)
 
 
 @pytest.mark.parametrize("law", DAMPED_LAWS)

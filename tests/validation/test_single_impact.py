@@ -42,7 +42,8 @@ def measured_impact(result):
 
 
 LAWS = {"lankarani_nikravesh": contact.LANKARANI_NIKRAVESH, "hunt_crossley": contact.HUNT_CROSSLEY,
-        "flores": contact.FLORES, "hertz": contact.HERTZ}
+        "flores": contact.FLORES, "gonthier": contact.GONTHIER, "hertz": contact.HERTZ}
+DAMPED_LAWS = sorted(set(LAWS) - {"hertz"})
 
 
 @pytest.mark.parametrize("law", sorted(LAWS))
@@ -71,3 +72,12 @@ def test_elastic_impact_matches_closed_form_hertz(simulate):
     assert np.max(result["joints/O/penetration"]) == pytest.approx(depth, rel=1e-4)
     assert np.max(result["joints/O/normal_force"]) == pytest.approx(contact.hertz_peak_force(mass, stiffness, speed), rel=1e-4)
     assert duration == pytest.approx(contact.hertz_contact_time(mass, stiffness, speed), rel=1e-6)
+
+
+@pytest.mark.parametrize("law", DAMPED_LAWS)
+@pytest.mark.parametrize("change", [{"mass": 0.05}, {"speed": 5.0}, {"speed": 0.05}])
+def test_damped_restitution_matches_the_reference_to_1e_4_at_any_mass_and_speed(simulate, law, change):
+    case = {"stiffness": 1e10, "mass": 1.0, "speed": 1.0} | change
+    measured, _, _ = measured_impact(simulate(impact_yaml(law, 0.8, **case)))
+    reference = law_impact(LAWS[law], 0.8, case["stiffness"], case["mass"], case["speed"])
+    assert measured == pytest.approx(reference.restitution, rel=1e-4)

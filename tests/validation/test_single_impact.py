@@ -75,7 +75,7 @@ def test_elastic_impact_matches_closed_form_hertz(simulate):
 
 
 @pytest.mark.parametrize("law", DAMPED_LAWS)
-@pytest.mark.parametrize("change", [{"mass": 0.05}, {"speed": 5.0}, {"speed": 0.05}])
+@pytest.mark.parametrize("change", [{}, {"mass": 0.05}, {"speed": 5.0}, {"speed": 0.05}])
 def test_damped_restitution_matches_the_reference_to_1e_4_at_any_mass_and_speed(simulate, law, change):
     case = {"stiffness": 1e10, "mass": 1.0, "speed": 1.0} | change
     measured, _, _ = measured_impact(simulate(impact_yaml(law, 0.8, **case)))

@@ -180,12 +180,32 @@ def _summary_table(report, summary) -> Table:
         table.add_row(f"joint {joint}: free / impact / contact", f"{free:.0%} / {impact:.0%} / {contact:.0%} of the time")
         if summary.sticking_share.get(joint, 0.0) > 0.0:
             table.add_row(f"joint {joint}: sticking", f"{summary.sticking_share[joint]:.0%} of the contact time")
+    for label, value in _travel_rows(summary.travel):
+        table.add_row(label, value)
     table.add_row("steps (rejected)", f"{stats.steps} ({stats.rejected_steps})")
     table.add_row("contact events", f"{stats.contact_events}")
     table.add_row("wall time", f"{stats.wall_time:.3f} s (integration)")
     table.add_row("compiled loop", f"{stats.kernel_time:.1f} s (compiled, first run)" if stats.kernels_compiled
                   else f"{stats.kernel_time:.2f} s (from the cache)")
     return table
+
+
+# figure of the `travel_figures` attribute → its label and how it is shown (SI value × scale, unit)
+TRAVEL_ROWS = {"operating_time_s": ("time to contact touch", 1e3, "ms"),
+               "zone_speed_m_per_s": ("speed-zone average speed", 1.0, "m/s"),
+               "total_travel_m": ("total travel", 1e3, "mm"), "overtravel_m": ("overtravel", 1e3, "mm"),
+               "rebound_m": ("rebound", 1e3, "mm"), "damping_duration_s": ("damping-zone duration", 1e3, "ms")}
+
+
+def _travel_rows(travel: dict) -> list[tuple[str, str]]:
+    """The summary rows of a run's travel figures ("not reached": a position the travel never crossed)."""
+    rows = []
+    for key, (label, scale, unit) in TRAVEL_ROWS.items():
+        if key in travel:
+            value = travel[key]
+            rows.append((f"{travel['sensor']}: {label}",
+                         "not reached" if value is None else f"{value * scale:.4g} {unit}"))
+    return rows
 
 
 def _print_plausibility_warnings(loaded) -> None:

@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import time
@@ -33,6 +34,7 @@ from clearsim.solver.outputs import (
 from clearsim.solver.samples import C_ECC_X, C_ECC_Y
 from clearsim.solver.simulate import Chunk, Run, Statistics
 from clearsim.solver import precompile
+from clearsim.travel import travel_figures
 from clearsim.whirl import joint_whirls, journal_paths, whirl_warnings
 
 BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
@@ -130,6 +132,16 @@ def _mode_attributes(system: System, loaded: LoadedMechanism, run: Run, whirls: 
     return {"flexible_modes": flexible_modes_attribute(system, links, loaded.base_dir, run.episode_log(), whirls)}
 
 
+def _travel_attributes(system: System, writer: ResultWriter) -> dict:
+    """`travel_figures`: the figures of the file's `travel:` block (clearsim.travel) as JSON, SI, from the samples
+    written (none when the file has no such block, or nothing could be written)."""
+    spec = system.mechanism.travel
+    if spec is None or writer.broken or "time" not in writer.file or f"sensors/{spec.sensor}" not in writer.file:
+        return {}
+    figures = travel_figures(writer.file["time"][()], writer.file[f"sensors/{spec.sensor}"][()], spec)
+    return {"travel_figures": json.dumps({"sensor": spec.sensor} | figures)}
+
+
 def _write_episodes(writer: ResultWriter, system: System, run: Run, sample_episodes: np.ndarray) -> None:
     """Episode tables per clearance joint and the final contact modes of every sample."""
     log = run.episode_log()
@@ -202,7 +214,7 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                 whirls = pending.whirls()
                 warnings = run.warnings() + whirl_warnings(whirls) if run is not None else []
                 final = _final_attributes(run, warnings) | _mode_attributes(system, loaded, run, whirls) \
-                    if run is not None else {}
+                    | _travel_attributes(system, writer) if run is not None else {}
                 readable = writer.finish(complete, status, final)
                 backup, identity, error = _give_its_name(writer, output, readable, error)
     return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
@@ -325,6 +337,7 @@ class Summary:
     sticking_share: dict[str, float]  # of the time in contact, per joint (files without /stick: absent)
     warnings: list[str] = field(default_factory=list)  # the file's `warnings` attribute, a line each
     flexible_modes: list[str] = field(default_factory=list)  # a line per flexible link (clearsim.model.modes)
+    travel: dict = field(default_factory=dict)  # the `travel_figures` attribute: sensor and figures, SI (clearsim.travel)
 
 
 SUMMARY_JOINT_DATASETS = ("/normal_force", "/mode", "/stick")
@@ -360,7 +373,8 @@ def summarize(path: Path, data: dict | None = None) -> Summary:
                 for j in joints if f"joints/{j}/stick" in data and np.any(data[f"joints/{j}/mode"] > 0)}
     warnings = [line for line in str(data["attrs"].get("warnings", "")).split("\n") if line]
     modes = mode_lines(str(data["attrs"].get("flexible_modes", "")))
-    return Summary(peak["velocity"], peak["acceleration"], forces, shares, sticking, warnings, modes)
+    travel = json.loads(str(data["attrs"].get("travel_figures", "{}")))
+    return Summary(peak["velocity"], peak["acceleration"], forces, shares, sticking, warnings, modes, travel)
 
 
 def _finite(values: np.ndarray) -> np.ndarray:

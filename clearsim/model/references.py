@@ -92,6 +92,8 @@ def check_references(mechanism: schema.Mechanism, known: dict[str, set] | None =
     for index, sensor in enumerate(mechanism.sensors):
         problems += _check_sensor(names, sensor, ("sensors", index))
     problems += _check_output(names, mechanism.output)
+    if mechanism.travel is not None:
+        problems += _check_sensor_kind(names, mechanism.travel.sensor, ("travel", "sensor"), "point_displacement", "travel")
     return list(dict.fromkeys(problems))
 
 
@@ -259,17 +261,20 @@ def _check_output(names: _Names, output: schema.OutputSensors) -> list[Problem]:
     problems = []
     for role, expected in OUTPUT_TYPES.items():
         name = getattr(output, role)
-        if name is None:
-            continue
-        fitting = [s.name for s in names.sensors.values() if s.type == expected]
-        path = ("output", role)
-        if name in names.known.get("sensors", ()):
-            continue
-        if name not in names.sensors:
-            problems.append(Problem(path, f"unknown sensor '{name}'{did_you_mean(name, names.sensors)}",
-                                    f"{expected} sensors in the file: {_listing(fitting)}"))
-        elif names.sensors[name].type != expected:
-            problems.append(Problem(path, f"output {role} must be a {expected} sensor; "
-                                    f"'{name}' is a {names.sensors[name].type}",
-                                    f"{expected} sensors in the file: {_listing(fitting)}"))
+        if name is not None:
+            problems += _check_sensor_kind(names, name, ("output", role), expected, f"output {role}")
     return problems
+
+
+def _check_sensor_kind(names: _Names, name: str, path: tuple, expected: str, role: str) -> list[Problem]:
+    """`name` is a sensor of type `expected` (one left out of the file as invalid is reported already)."""
+    fitting = [s.name for s in names.sensors.values() if s.type == expected]
+    if name in names.known.get("sensors", ()):
+        return []
+    if name not in names.sensors:
+        return [Problem(path, f"unknown sensor '{name}'{did_you_mean(name, names.sensors)}",
+                        f"{expected} sensors in the file: {_listing(fitting)}")]
+    if names.sensors[name].type != expected:
+        return [Problem(path, f"{role} must be a {expected} sensor; '{name}' is a {names.sensors[name].type}",
+                        f"{expected} sensors in the file: {_listing(fitting)}")]
+    return []

@@ -365,6 +365,28 @@ class OutputSensors(Strict):
     acceleration: str | None = Field(None, description="name of the point_acceleration sensor that is the output")
 
 
+class TravelCurve(Strict):
+    """The travel-curve figures `clearsim run` reports (docs/plotting.md "Travel curve"): positions are the sensor's
+    signed displacement from t = 0."""
+
+    sensor: str = Field(description="name of the point_displacement sensor whose travel is analysed")
+    command_time: Time = Field(0.0, ge=0.0, description="time of the operating command; default 0 s")
+    contact_touch: Length = Field(description="position at which the contacts touch (closing) or part (opening)")
+    speed_zone: tuple[Length, Length] = Field(description="the two positions, in the order the contact passes them, "
+                                              "between which the average speed is taken")
+    damping_start: Length | None = Field(None, description="position at which the damping zone begins; default: no damping-zone duration")
+    settle_tolerance: Length = Field(1e-3, gt=0.0, description="distance from the final rest position within which "
+                                     "the motion counts as ended; default 1 mm")
+
+    @field_validator("speed_zone")
+    @classmethod
+    def _zone_in_travel_order(cls, zone: tuple[float, float]) -> tuple[float, float]:
+        if zone[0] * zone[1] < 0.0 or abs(zone[1]) <= abs(zone[0]):
+            raise ValueError("the speed zone's two positions must be in the order the contact passes them from its "
+                             "start position: the second farther from it, on the same side, e.g. [230 mm, 250 mm]")
+        return zone
+
+
 # --- solver ---------------------------------------------------------------------------------------
 
 
@@ -544,6 +566,7 @@ class Mechanism(Strict):
     forces: list[AppliedForce] = Field(default_factory=list)
     sensors: list[Sensor] = Field(default_factory=list)
     output: OutputSensors = OutputSensors()
+    travel: TravelCurve | None = Field(None, description="travel-curve figures of a named displacement sensor in the run summary")
     solver: SolverSettings
     tolerances: list[Tolerance] = Field(
         default_factory=list, description="random distributions of values for `clearsim sweep --sample N`; ignored by `run`")

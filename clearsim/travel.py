@@ -1,0 +1,100 @@
+"""Travel-curve figures of merit of a breaker operation, from a travel history x(t) (m, s).
+
+The figures a breaker travel analyser reports (docs/plotting.md "Travel curve"): operating time to contact touch,
+average speed over a contact zone, total travel, overtravel, rebound and the damping-zone duration. Positions are
+the sensor's signed displacement from t = 0; crossings are interpolated linearly between samples. A figure the
+history does not reach (a position never crossed) is None.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def first_crossing(time: np.ndarray, travel: np.ndarray, position: float, after: float = -np.inf) -> float | None:
+    """The first time at or after `after` at which the travel reaches `position`, interpolated linearly; None if never."""
+    offset = np.asarray(travel, dtype=float) - position
+    time = np.asarray(time, dtype=float)
+    first = max(0, int(np.searchsorted(time, after, side="right")) - 1)  # the interval holding `after`
+    for i in range(first, len(offset)):
+        crossing = None
+        if offset[i] == 0.0:
+            crossing = float(time[i])
+        elif i + 1 < len(offset) and offset[i] * offset[i + 1] < 0.0:
+            share = offset[i] / (offset[i] - offset[i + 1])
+            crossing = float(time[i] + share * (time[i + 1] - time[i]))
+        if crossing is not None and crossing >= after:
+            return crossing
+    return None
+
+
+def operating_time(time: np.ndarray, travel: np.ndarray, contact_touch: float, command_time: float = 0.0) -> float | None:
+    """Closing (or opening) time: from the command to the first time the travel reaches the contact-touch position."""
+    touch = first_crossing(time, travel, contact_touch, command_time)
+    return None if touch is None else touch - command_time
+
+
+def zone_speed(time: np.ndarray, travel: np.ndarray, zone: tuple[float, float]) -> float | None:
+    """Average speed over the zone: |x₂ − x₁| / (t₂ − t₁), t₁, t₂ the first times the travel reaches x₁, then x₂."""
+    start = first_crossing(time, travel, zone[0])
+    end = None if start is None else first_crossing(time, travel, zone[1], start)
+    if end is None or end == start:
+        return None
+    return abs(zone[1] - zone[0]) / (end - start)
+
+
+def total_travel(travel: np.ndarray) -> float:
+    """Total travel: |x_rest − x(0)|, x_rest the final rest position (the last sample)."""
+    return float(abs(travel[-1] - travel[0]))
+
+
+def _stroke_sign(travel: np.ndarray) -> float:
+    return 1.0 if travel[-1] >= travel[0] else -1.0
+
+
+def overtravel(travel: np.ndarray) -> float:
+    """Overtravel: the largest travel beyond the final rest position, in the stroke direction (0 if none)."""
+    sign = _stroke_sign(travel)
+    return float(max(0.0, np.max(sign * (np.asarray(travel) - travel[-1]))))
+
+
+def rebound(travel: np.ndarray) -> float:
+    """Rebound: the travel back, against the stroke direction, from the farthest position to the lowest one after it."""
+    along = _stroke_sign(travel) * np.asarray(travel, dtype=float)
+    farthest = int(np.argmax(along))
+    return float(along[farthest] - np.min(along[farthest:]))
+
+
+def settling_time(time: np.ndarray, travel: np.ndarray, tolerance: float) -> float:
+    """The time after which the travel stays within `tolerance` of the final rest position (band entry interpolated)."""
+    offset = np.abs(np.asarray(travel, dtype=float) - travel[-1]) - tolerance
+    outside = np.flatnonzero(offset > 0.0)
+    if len(outside) == 0:
+        return float(time[0])
+    i = outside[-1]
+    share = offset[i] / (offset[i] - offset[i + 1])
+    return float(time[i] + share * (time[i + 1] - time[i]))
+
+
+def damping_duration(time: np.ndarray, travel: np.ndarray, damping_start: float, tolerance: float) -> float | None:
+    """Damping-zone duration: from the first time the travel reaches `damping_start` to the settling time."""
+    start = first_crossing(time, travel, damping_start)
+    return None if start is None else max(0.0, settling_time(time, travel, tolerance) - start)
+
+
+def travel_figures(time: np.ndarray, travel: np.ndarray, spec) -> dict[str, float | None]:
+    """Every figure of a `travel:` block (clearsim.model.schema.TravelCurve), SI, by name."""
+    time, travel = np.asarray(time, dtype=float), np.asarray(travel, dtype=float)
+    finite = np.isfinite(travel) & np.isfinite(time)
+    time, travel = time[finite], travel[finite]
+    if len(travel) < 2:
+        return {}
+    return {
+        "operating_time_s": operating_time(time, travel, spec.contact_touch, spec.command_time),
+        "zone_speed_m_per_s": zone_speed(time, travel, spec.speed_zone),
+        "total_travel_m": total_travel(travel),
+        "overtravel_m": overtravel(travel),
+        "rebound_m": rebound(travel),
+        "damping_duration_s": None if spec.damping_start is None
+        else damping_duration(time, travel, spec.damping_start, spec.settle_tolerance),
+    }

@@ -93,7 +93,8 @@ def check_references(mechanism: schema.Mechanism, known: dict[str, set] | None =
         problems += _check_sensor(names, sensor, ("sensors", index))
     problems += _check_output(names, mechanism.output)
     if mechanism.travel is not None:
-        problems += _check_sensor_kind(names, mechanism.travel.sensor, ("travel", "sensor"), "point_displacement", "travel")
+        problems += _check_sensor_kind(names, mechanism.travel.sensor, ("travel", "sensor"), "point_displacement",
+                                      "the travel sensor")
     return list(dict.fromkeys(problems))
 
 

@@ -1,0 +1,84 @@
+"""`clearsim run` with a `travel:` block: the travel figures in the summary and the result file; bad blocks exit 2
+at their place."""
+
+import json
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from clearsim.cli import app
+
+UHV = Path(__file__).resolve().parents[2] / "clearsim" / "configs" / "uhv_breaker.yaml"
+OUTPUT_LINE = "output: {displacement"
+runner = CliRunner()
+
+
+def with_travel(tmp_path, block: str) -> Path:
+    """The bundled UHV breaker with `travel: {block}` added before its `output:` line."""
+    text = UHV.read_text()
+    assert OUTPUT_LINE in text
+    config = tmp_path / "uhv_travel.yaml"
+    config.write_text(text.replace(OUTPUT_LINE, f"travel: {{{block}}}\n{OUTPUT_LINE}", 1))
+    return config
+
+
+def crossing_bracket(time, travel, position):
+    """The two sample times between which the travel first reaches `position`."""
+    i = int(np.argmax(travel >= position))
+    return time[i - 1], time[i]
+
+
+def test_a_uhv_run_prints_and_stores_the_travel_figures(tmp_path):
+    config = with_travel(tmp_path, "sensor: contact_displacement, contact_touch: 250 mm, "
+                                   "speed_zone: [230 mm, 250 mm], damping_start: 280 mm")
+    out = tmp_path / "uhv.h5"
+    result = runner.invoke(app, ["run", str(config), "-o", str(out)], terminal_width=200)
+    assert result.exit_code == 0, result.output
+    with h5py.File(out) as f:
+        figures = json.loads(f.attrs["travel_figures"])
+        time, travel = f["time"][()], f["sensors/contact_displacement"][()]
+    assert figures["sensor"] == "contact_displacement"
+    touch = figures["operating_time_s"]
+    early, late = crossing_bracket(time, travel, 0.250)
+    assert early <= touch <= late
+    (start_early, start_late), (end_early, end_late) = (crossing_bracket(time, travel, x) for x in (0.230, 0.250))
+    assert 0.020 / (end_late - start_early) <= figures["zone_speed_m_per_s"] <= 0.020 / (end_early - start_late)
+    assert figures["total_travel_m"] == pytest.approx(abs(travel[-1] - travel[0]), rel=1e-12)
+    assert figures["overtravel_m"] == pytest.approx(max(0.0, np.max(travel - travel[-1])), rel=1e-12, abs=1e-15)
+    assert figures["damping_duration_s"] > 0.0
+    for label, value in (("time to contact touch", f"{touch * 1e3:.4g} ms"),
+                         ("speed-zone average speed", f"{figures['zone_speed_m_per_s']:.4g} m/s"),
+                         ("total travel", f"{figures['total_travel_m'] * 1e3:.4g} mm"),
+                         ("overtravel", "mm"), ("rebound", "mm"),
+                         ("damping-zone duration", f"{figures['damping_duration_s'] * 1e3:.4g} ms")):
+        line = next((text for text in result.output.splitlines() if f"contact_displacement: {label}" in text), "")
+        assert value in line, (label, result.output)
+
+
+def test_a_run_without_a_travel_block_has_no_travel_figures(tmp_path):
+    out = tmp_path / "uhv.h5"
+    result = runner.invoke(app, ["run", str(UHV), "-o", str(out), "--set", "solver.t_end=2ms"], terminal_width=200)
+    assert result.exit_code == 0, result.output
+    assert "time to contact touch" not in result.output
+    with h5py.File(out) as f:
+        assert "travel_figures" not in f.attrs
+
+
+@pytest.mark.parametrize("block, place, message", [
+    ("sensor: contact_displacment, contact_touch: 250 mm, speed_zone: [230 mm, 250 mm]", "travel → sensor",
+     "unknown sensor 'contact_displacment'; did you mean 'contact_displacement'?"),
+    ("sensor: contact_velocity, contact_touch: 250 mm, speed_zone: [230 mm, 250 mm]", "travel → sensor",
+     "the travel sensor must be a point_displacement sensor; 'contact_velocity' is a point_velocity"),
+    ("sensor: contact_displacement, contact_touch: 250 mm, speed_zone: [250 mm, 230 mm]", "travel → speed_zone",
+     "the speed zone's two positions must be in the order the contact passes them"),
+], ids=["unknown sensor", "not a displacement", "zone reversed"])
+def test_a_bad_travel_block_exits_2_at_its_place(tmp_path, block, place, message):
+    config = with_travel(tmp_path, block)
+    line = next(number for number, text in enumerate(config.read_text().splitlines(), 1) if text.startswith("travel:"))
+    result = runner.invoke(app, ["run", str(config), "-o", str(tmp_path / "bad.h5")], terminal_width=200)
+    assert result.exit_code == 2, result.output
+    assert f"{config}:{line}:" in result.output and place in result.output and message in result.output
+    assert "Traceback" not in result.output and not (tmp_path / "bad.h5").exists()

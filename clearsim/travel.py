@@ -13,19 +13,13 @@ import numpy as np
 
 def first_crossing(time: np.ndarray, travel: np.ndarray, position: float, after: float = -np.inf) -> float | None:
     """The first time at or after `after` at which the travel reaches `position`, interpolated linearly; None if never."""
-    offset = np.asarray(travel, dtype=float) - position
-    time = np.asarray(time, dtype=float)
-    first = max(0, int(np.searchsorted(time, after, side="right")) - 1)  # the interval holding `after`
-    for i in range(first, len(offset)):
-        crossing = None
-        if offset[i] == 0.0:
-            crossing = float(time[i])
-        elif i + 1 < len(offset) and offset[i] * offset[i + 1] < 0.0:
-            share = offset[i] / (offset[i] - offset[i + 1])
-            crossing = float(time[i] + share * (time[i + 1] - time[i]))
-        if crossing is not None and crossing >= after:
-            return crossing
-    return None
+    offset, time = np.asarray(travel, dtype=float) - position, np.asarray(time, dtype=float)
+    at_sample = np.flatnonzero(offset == 0.0)
+    between = np.flatnonzero(offset[:-1] * offset[1:] < 0.0)  # strictly between sample i and i + 1
+    share = offset[between] / (offset[between] - offset[between + 1])
+    times = np.sort(np.concatenate([time[at_sample], time[between] + share * np.diff(time)[between]]))
+    times = times[times >= after]
+    return float(times[0]) if len(times) else None
 
 
 def operating_time(time: np.ndarray, travel: np.ndarray, contact_touch: float, command_time: float = 0.0) -> float | None:

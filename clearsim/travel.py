@@ -77,18 +77,20 @@ def damping_duration(time: np.ndarray, travel: np.ndarray, damping_start: float,
 
 
 def travel_figures(time: np.ndarray, travel: np.ndarray, spec) -> dict[str, float | None]:
-    """Every figure of a `travel:` block (clearsim.model.schema.TravelCurve), SI, by name."""
+    """Every figure of a `travel:` block (clearsim.model.schema.TravelCurve), SI, by name (the damping-zone duration
+    only with a `damping_start`)."""
     time, travel = np.asarray(time, dtype=float), np.asarray(travel, dtype=float)
     finite = np.isfinite(travel) & np.isfinite(time)
     time, travel = time[finite], travel[finite]
     if len(travel) < 2:
         return {}
-    return {
+    figures = {
         "operating_time_s": operating_time(time, travel, spec.contact_touch, spec.command_time),
         "zone_speed_m_per_s": zone_speed(time, travel, spec.speed_zone),
         "total_travel_m": total_travel(travel),
         "overtravel_m": overtravel(travel),
         "rebound_m": rebound(travel),
-        "damping_duration_s": None if spec.damping_start is None
-        else damping_duration(time, travel, spec.damping_start, spec.settle_tolerance),
     }
+    if spec.damping_start is None:  # no damping zone stated: no such figure
+        return figures
+    return figures | {"damping_duration_s": damping_duration(time, travel, spec.damping_start, spec.settle_tolerance)}

@@ -58,6 +58,20 @@ def test_a_uhv_run_prints_and_stores_the_travel_figures(tmp_path):
         assert value in line, (label, result.output)
 
 
+def test_a_run_ending_before_contact_touch_says_not_reached(tmp_path):
+    config = with_travel(tmp_path, "sensor: contact_displacement, contact_touch: 250 mm, speed_zone: [230 mm, 250 mm]")
+    out = tmp_path / "uhv.h5"
+    result = runner.invoke(app, ["run", str(config), "-o", str(out), "--set", "solver.t_end=5ms"], terminal_width=200)
+    assert result.exit_code == 0, result.output
+    with h5py.File(out) as f:
+        figures = json.loads(f.attrs["travel_figures"])
+    assert figures["operating_time_s"] is None and figures["zone_speed_m_per_s"] is None
+    assert "damping_duration_s" not in figures and "damping-zone duration" not in result.output  # none stated
+    for label in ("time to contact touch", "speed-zone average speed"):
+        line = next(text for text in result.output.splitlines() if f"contact_displacement: {label}" in text)
+        assert "not reached" in line, result.output
+
+
 def test_a_run_without_a_travel_block_has_no_travel_figures(tmp_path):
     out = tmp_path / "uhv.h5"
     result = runner.invoke(app, ["run", str(UHV), "-o", str(out), "--set", "solver.t_end=2ms"], terminal_width=200)

@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 from clearsim.errors import ClearsimError
-from clearsim.io.hdf5 import keep_as_previous
+from clearsim.io.files import partial_name, publish
 from clearsim.solver import precompile
 from clearsim.sweep.grid import SweepOptionError
 from clearsim.sweep.worker import (FAILED, INTERRUPTED, CaseOutcome, CaseTask, init_pool_worker, load_case,
@@ -418,11 +418,10 @@ def _received(task: CaseTask, future) -> CaseOutcome:
     if data is None:
         return outcome
     output = Path(task.output)
-    partial = output.with_name(output.name + ".part")
+    partial = partial_name(output)
     try:
         partial.write_bytes(data)
-        keep_as_previous(output)
-        partial.replace(output)
+        publish(partial, output)
     except OSError as exc:
         partial.unlink(missing_ok=True)
         return CaseOutcome(task.name, FAILED, True, f"its result file ({len(data) / 1e6:.1f} MB) came back from "

@@ -316,6 +316,7 @@ def sweep(
 def validate(config: Optional[Path] = ConfigArgument, overrides: List[str] = SetOption) -> None:
     """Check a mechanism file (schema, names, units, assembly) without running it."""
     from clearsim.runner import BUNDLED_CONFIG, prepare
+    from clearsim.model.flexible import flexible_link_names
     from clearsim.model.loader import load_mechanism
 
     loaded = load_mechanism(config or BUNDLED_CONFIG, overrides)
@@ -323,7 +324,7 @@ def validate(config: Optional[Path] = ConfigArgument, overrides: List[str] = Set
     system = prepare(loaded)
     mechanism = system.mechanism
     written = {key: loaded.document.get(key) or [] for key in ("bodies", "joints")}  # as in the file, not expanded
-    flexible = [body.get("name") for body in written["bodies"] if isinstance(body, dict) and "flexible" in body]
+    flexible = flexible_link_names(loaded.document)
     stretches = f", {len(flexible)} from flexible links: {', '.join(flexible)}" if flexible else ""
     console.print(f"{loaded.path}: OK — {len(written['bodies'])} bodies, {len(written['joints'])} joints, "
                   f"{len(mechanism.drivers)} drivers, {system.degrees_of_freedom} degrees of freedom "

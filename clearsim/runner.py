@@ -27,7 +27,8 @@ from clearsim.io.hdf5 import (
     result_overview, write_failure,
 )
 from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
-from clearsim.model.modes import flexible_link_names, flexible_modes_attribute, mode_lines
+from clearsim.model.flexible import flexible_link_names
+from clearsim.model.modes import flexible_modes_attribute, mode_lines
 from clearsim.solver.outputs import (
     classify_episodes, chunk_outputs, full_precision, output_rate, sample_modes, stored_outputs,
 )

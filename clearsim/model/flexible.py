@@ -177,6 +177,11 @@ def point_text(point) -> list[str]:
     return [si_text(coordinate, "length") for coordinate in point]
 
 
+def flexible_link_names(document: dict) -> list[str]:
+    """The bodies the file declares flexible, in file order."""
+    return [body["name"] for body in document.get("bodies") or [] if isinstance(body, dict) and body.get("flexible")]
+
+
 def flexible_problems(mechanism) -> list[Problem]:
     """Each flexible body that cannot be split: not exactly two revolute joints, in a prismatic joint or driven,
     its joints at one point, or its new names taken."""

@@ -42,11 +42,6 @@ def near(mode: float, lowest: float, highest: float, factor: float = NEAR_FACTOR
     return lowest / factor <= mode <= highest * factor
 
 
-def flexible_link_names(document: dict) -> list[str]:
-    """The bodies the file declares flexible, in file order."""
-    return [body["name"] for body in document.get("bodies") or [] if isinstance(body, dict) and body.get("flexible")]
-
-
 def _closed_clearances(mechanism):
     """The mechanism with every clearance joint an ideal pin."""
     joints = [joint.model_copy(update={"clearance": None, "journal_radius": None})

@@ -11,7 +11,8 @@ from typer.testing import CliRunner
 from clearsim.cli import app
 from clearsim.io.hdf5 import read_result
 from clearsim.model.loader import load_mechanism_text
-from clearsim.model.modes import (JointFrequencies, axial_mode_frequencies, flexible_link_names, mode_lines,
+from clearsim.model.flexible import flexible_link_names
+from clearsim.model.modes import (JointFrequencies, axial_mode_frequencies, mode_lines,
                                   mode_report, near)
 
 from tests.validation.test_flexible_axial import LINK, OMEGA, PERIOD, STIFFNESS, TIP, mass_on_link

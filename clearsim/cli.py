@@ -205,6 +205,10 @@ def _travel_rows(travel: dict) -> list[tuple[str, str]]:
             value = travel[key]
             rows.append((f"{travel['sensor']}: {label}",
                          "not reached" if value is None else f"{value * scale:.4g} {unit}"))
+    if "inside_envelope" in travel:
+        from clearsim.travel import envelope_verdict
+
+        rows.append((f"{travel['sensor']}: within the envelope", envelope_verdict(travel)))
     return rows
 
 

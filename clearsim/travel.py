@@ -3,7 +3,8 @@
 The figures a breaker travel analyser reports (docs/plotting.md "Travel curve"): operating time to contact touch,
 average speed over a contact zone, total travel, overtravel, rebound and the damping-zone duration. Positions are
 the sensor's signed displacement from t = 0; crossings are interpolated linearly between samples. A figure the
-history does not reach (a position never crossed) is None.
+history does not reach (a position never crossed) is None. An optional tolerance envelope (a lower and an upper
+limit curve) is checked against the whole curve: inside or not, where it first leaves, how far it goes beyond.
 """
 
 from __future__ import annotations
@@ -78,7 +79,7 @@ def damping_duration(time: np.ndarray, travel: np.ndarray, damping_start: float,
 
 def travel_figures(time: np.ndarray, travel: np.ndarray, spec) -> dict[str, float | None]:
     """Every figure of a `travel:` block (clearsim.model.schema.TravelCurve), SI, by name (the damping-zone duration
-    only with a `damping_start`)."""
+    only with a `damping_start`, the envelope check only with an `envelope`)."""
     time, travel = np.asarray(time, dtype=float), np.asarray(travel, dtype=float)
     finite = np.isfinite(travel) & np.isfinite(time)
     time, travel = time[finite], travel[finite]
@@ -91,6 +92,80 @@ def travel_figures(time: np.ndarray, travel: np.ndarray, spec) -> dict[str, floa
         "overtravel_m": overtravel(travel),
         "rebound_m": rebound(travel),
     }
-    if spec.damping_start is None:  # no damping zone stated: no such figure
-        return figures
-    return figures | {"damping_duration_s": damping_duration(time, travel, spec.damping_start, spec.settle_tolerance)}
+    if spec.damping_start is not None:  # no damping zone stated: no such figure
+        figures["damping_duration_s"] = damping_duration(time, travel, spec.damping_start, spec.settle_tolerance)
+    envelope = getattr(spec, "envelope", None)
+    if envelope is not None:
+        figures |= envelope_check(time, travel, envelope.lower, envelope.upper)
+    return figures
+
+
+# --- tolerance envelope: a lower and an upper limit curve, each straight between its [time, travel] points ---------
+
+
+def envelope_span(lower: np.ndarray, upper: np.ndarray) -> tuple[float, float]:
+    """The times both limit curves cover ([time, travel] rows, SI): the envelope holds there, nowhere else."""
+    return max(lower[0, 0], upper[0, 0]), min(lower[-1, 0], upper[-1, 0])
+
+
+def _knots(span: tuple[float, float], *times: np.ndarray) -> np.ndarray:
+    """Every time in `times` within the span, and its two ends: between two of them all curves are straight."""
+    every = np.concatenate([np.asarray(t, dtype=float) for t in times] + [np.array(span)])
+    return np.unique(every[(every >= span[0]) & (every <= span[1])])
+
+
+def _on(knots: np.ndarray, points: np.ndarray) -> np.ndarray:
+    return np.interp(knots, points[:, 0], points[:, 1])
+
+
+def crossed_limits(lower, upper) -> tuple[float, float, float] | None:
+    """(time, lower, upper) at the first corner where the lower limit lies above the upper one; None when it never
+    does (the limits are straight between corners, so the corners decide)."""
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    knots = _knots(envelope_span(lower, upper), lower[:, 0], upper[:, 0])
+    low, high = _on(knots, lower), _on(knots, upper)
+    crossed = np.flatnonzero(low > high)
+    return None if not len(crossed) else (float(knots[crossed[0]]), float(low[crossed[0]]), float(high[crossed[0]]))
+
+
+def _zero_entry(start: float, end: float, before: float, after: float) -> float:
+    """Where a straight line from `before` (≤ 0) at `start` to `after` (> 0) at `end` passes 0."""
+    return start + (end - start) * (-before) / (after - before)
+
+
+def envelope_check(time: np.ndarray, travel: np.ndarray, lower, upper) -> dict[str, bool | float | None]:
+    """Whether the travel (straight between samples) stays within the limits over the times both cover, and if not
+    the first time it leaves them and the largest excursion beyond a limit (with its time). Exact for the straight
+    pieces: every sample time and every limit corner is a knot, between two knots the excursions are straight."""
+    time, travel = np.asarray(time, dtype=float), np.asarray(travel, dtype=float)
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    start, end = envelope_span(lower, upper)
+    span = (max(start, time[0]), min(end, time[-1]))
+    inside = {"inside_envelope": True, "envelope_first_outside_s": None, "envelope_largest_excursion_m": 0.0,
+              "envelope_largest_excursion_at_s": None}
+    if span[0] > span[1]:  # the curve ends before the envelope begins: nothing to check
+        return inside | {"inside_envelope": None}
+    knots = _knots(span, time, lower[:, 0], upper[:, 0])
+    position = np.interp(knots, time, travel)
+    above, below = position - _on(knots, upper), _on(knots, lower) - position
+    excursion = np.maximum(above, below)
+    outside = np.flatnonzero(excursion > 0.0)
+    if not len(outside):
+        return inside
+    i, largest = outside[0], int(np.argmax(excursion))
+    first = knots[i] if i == 0 else min(_zero_entry(knots[i - 1], knots[i], side[i - 1], side[i])
+                                        for side in (above, below) if side[i] > 0.0)
+    return {"inside_envelope": False, "envelope_first_outside_s": float(first),
+            "envelope_largest_excursion_m": float(excursion[largest]),
+            "envelope_largest_excursion_at_s": float(knots[largest])}
+
+
+def envelope_verdict(figures: dict) -> str:
+    """The envelope check of a `travel_figures` record in words, with the first exit and the largest excursion."""
+    inside = figures["inside_envelope"]
+    if inside is None:
+        return "not checked: the run ends before the envelope begins"
+    if inside:
+        return "yes"
+    return (f"no: leaves it at {figures['envelope_first_outside_s'] * 1e3:.4g} ms, largest excursion "
+            f"{figures['envelope_largest_excursion_m'] * 1e3:.4g} mm at {figures['envelope_largest_excursion_at_s'] * 1e3:.4g} ms")

@@ -46,6 +46,7 @@ from clearsim.units import (
     unit_name,
     unit_system,
 )
+from clearsim.travel import crossed_limits
 
 RawQuantity = Union[float, str]  # converted where its kind is known (a driver's stroke: m or rad)
 
@@ -365,6 +366,41 @@ class OutputSensors(Strict):
     acceleration: str | None = Field(None, description="name of the point_acceleration sensor that is the output")
 
 
+def _in_time_order(points: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    for number, (before, after) in enumerate(zip(points, points[1:]), 1):
+        if after[0] <= before[0]:
+            raise ValueError(f"the times of a limit curve must increase: point {number + 1} "
+                             f"({after[0] * 1e3:g} ms) does not come after point {number} ({before[0] * 1e3:g} ms); "
+                             "list the [time, travel] pairs in time order, e.g. [[0 ms, 0 mm], [40 ms, 150 mm]]")
+    return points
+
+
+class TravelEnvelope(Strict):
+    """The tolerance band of the travel curve: a lower and an upper limit curve, each straight between its
+    [time, travel] points (time from t = 0, travel as the sensor's); checked where both are given."""
+
+    lower: list[tuple[Time, Length]] = Field(min_length=2, description="lower limit curve: [time, travel] pairs, "
+                                             "times increasing, e.g. [[0 ms, 0 mm], [60 ms, 230 mm]]")
+    upper: list[tuple[Time, Length]] = Field(min_length=2, description="upper limit curve: [time, travel] pairs, "
+                                             "times increasing")
+
+    _limits_in_time_order = field_validator("lower", "upper")(_in_time_order)
+
+    @model_validator(mode="after")
+    def _lower_below_upper(self):
+        lower, upper = self.lower, self.upper
+        if max(lower[0][0], upper[0][0]) >= min(lower[-1][0], upper[-1][0]):
+            raise ValueError(f"the lower limit ({lower[0][0] * 1e3:g} to {lower[-1][0] * 1e3:g} ms) and the upper "
+                             f"limit ({upper[0][0] * 1e3:g} to {upper[-1][0] * 1e3:g} ms) share no time span: give "
+                             "both over the same times")
+        crossed = crossed_limits(lower, upper)
+        if crossed is not None:
+            time, low, high = crossed
+            raise ValueError(f"the lower limit is above the upper one at {time * 1e3:g} ms ({low * 1e3:g} mm > "
+                             f"{high * 1e3:g} mm): swap `lower` and `upper`, or correct that point")
+        return self
+
+
 class TravelCurve(Strict):
     """The travel-curve figures `clearsim run` reports (docs/plotting.md "Travel curve"): positions are the sensor's
     signed displacement from t = 0."""
@@ -377,6 +413,8 @@ class TravelCurve(Strict):
     damping_start: Length | None = Field(None, description="position at which the damping zone begins; default: no damping-zone duration")
     settle_tolerance: Length = Field(1e-3, gt=0.0, description="distance from the final rest position within which "
                                      "the motion counts as ended; default 1 mm")
+    envelope: TravelEnvelope | None = Field(None, description="tolerance band the travel curve must stay in; "
+                                            "default: none")
 
     @field_validator("speed_zone")
     @classmethod

@@ -190,26 +190,10 @@ def _summary_table(report, summary) -> Table:
     return table
 
 
-# figure of the `travel_figures` attribute → its label and how it is shown (SI value × scale, unit)
-TRAVEL_ROWS = {"operating_time_s": ("time to contact touch", 1e3, "ms"),
-               "zone_speed_m_per_s": ("speed-zone average speed", 1.0, "m/s"),
-               "total_travel_m": ("total travel", 1e3, "mm"), "overtravel_m": ("overtravel", 1e3, "mm"),
-               "rebound_m": ("rebound", 1e3, "mm"), "damping_duration_s": ("damping-zone duration", 1e3, "ms")}
-
-
 def _travel_rows(travel: dict) -> list[tuple[str, str]]:
-    """The summary rows of a run's travel figures ("not reached": a position the travel never crossed)."""
-    rows = []
-    for key, (label, scale, unit) in TRAVEL_ROWS.items():
-        if key in travel:
-            value = travel[key]
-            rows.append((f"{travel['sensor']}: {label}",
-                         "not reached" if value is None else f"{value * scale:.4g} {unit}"))
-    if "inside_envelope" in travel:
-        from clearsim.travel import envelope_verdict
+    from clearsim.travel import figure_rows
 
-        rows.append((f"{travel['sensor']}: within the envelope", envelope_verdict(travel)))
-    return rows
+    return [(f"{travel['sensor']}: {label}", value) for label, value in figure_rows(travel)]
 
 
 def _print_plausibility_warnings(loaded) -> None:

@@ -118,12 +118,17 @@ def _on(knots: np.ndarray, points: np.ndarray) -> np.ndarray:
     return np.interp(knots, points[:, 0], points[:, 1])
 
 
+def limit_band(lower, upper) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(time, lower, upper) at every corner of either limit curve over the times both cover."""
+    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    knots = _knots(envelope_span(lower, upper), lower[:, 0], upper[:, 0])
+    return knots, _on(knots, lower), _on(knots, upper)
+
+
 def crossed_limits(lower, upper) -> tuple[float, float, float] | None:
     """(time, lower, upper) at the first corner where the lower limit lies above the upper one; None when it never
     does (the limits are straight between corners, so the corners decide)."""
-    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
-    knots = _knots(envelope_span(lower, upper), lower[:, 0], upper[:, 0])
-    low, high = _on(knots, lower), _on(knots, upper)
+    knots, low, high = limit_band(lower, upper)
     crossed = np.flatnonzero(low > high)
     return None if not len(crossed) else (float(knots[crossed[0]]), float(low[crossed[0]]), float(high[crossed[0]]))
 
@@ -169,3 +174,20 @@ def envelope_verdict(figures: dict) -> str:
         return "yes"
     return (f"no: leaves it at {figures['envelope_first_outside_s'] * 1e3:.4g} ms, largest excursion "
             f"{figures['envelope_largest_excursion_m'] * 1e3:.4g} mm at {figures['envelope_largest_excursion_at_s'] * 1e3:.4g} ms")
+
+
+# figure of a `travel_figures` record → its label and how it is shown (SI value × scale, unit)
+FIGURE_ROWS = {"operating_time_s": ("time to contact touch", 1e3, "ms"),
+               "zone_speed_m_per_s": ("speed-zone average speed", 1.0, "m/s"),
+               "total_travel_m": ("total travel", 1e3, "mm"), "overtravel_m": ("overtravel", 1e3, "mm"),
+               "rebound_m": ("rebound", 1e3, "mm"), "damping_duration_s": ("damping-zone duration", 1e3, "ms")}
+
+
+def figure_rows(figures: dict) -> list[tuple[str, str]]:
+    """(label, value with its unit) of each figure of a `travel_figures` record ("not reached": a position the
+    travel never crossed), and the envelope verdict when an envelope was given."""
+    rows = [(label, "not reached" if figures[key] is None else f"{figures[key] * scale:.4g} {unit}")
+            for key, (label, scale, unit) in FIGURE_ROWS.items() if key in figures]
+    if "inside_envelope" in figures:
+        rows.append(("within the envelope", envelope_verdict(figures)))
+    return rows

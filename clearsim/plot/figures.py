@@ -7,6 +7,7 @@ leaves no half-written set behind. File names are stable (docs/plotting.md):
     <stem>-joint-<J>.png   clearance joint J: journal path, contact forces, penetration
     <stem>-spectrum.png    amplitude spectrum of the output acceleration (or the --sensor ones)
     <stem>-energy.png      energy balance and constraint violation
+    <stem>-travel.png      travel curve in its tolerance envelope, with its figures (mechanisms with `travel:`)
     <stem>-measured.png    simulation over measurement, residual below (--measured)
     <stem>-merit.png       sweep folders with summary.csv: figures of merit against the swept quantity
     <stem>-animation.gif   the mechanism moving (--animate), one per run
@@ -19,7 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from clearsim.plot import history, journal, measured as measured_plots, sweep
+from clearsim.plot import history, journal, measured as measured_plots, sweep, travel
 from clearsim.plot.animate import animate_run, check_animation, parse_exaggerate
 from clearsim.plot.data import PlotInputError, RunData, apply_window, load_run, parse_time_window, signals
 from clearsim.plot.labels import run_labels
@@ -137,6 +138,8 @@ def build_figures(runs: list[RunData], request: PlotRequest, folder: Path | None
     if spectrum:
         figures["spectrum"] = history.spectrum_figure(runs, spectrum, show)
     figures["energy"] = history.energy_figure(runs, show)
+    if travel.travel_runs(runs):
+        figures["travel"] = travel.travel_figure(runs, show)
     if request.measured is not None:
         record = measured_plots.read_measurement(request.measured, measured_plots.run_sensor_units(runs[0]),
                                                  str(runs[0].path))

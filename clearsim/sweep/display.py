@@ -14,7 +14,7 @@ from rich.table import Table
 
 from clearsim.sweep.execute import SweepResult
 from clearsim.sweep.plan import SweepPlan
-from clearsim.sweep.summary import JOINT_FIGURES, PERCENTILES, joint_column, percentile_header
+from clearsim.sweep.summary import ENVELOPE_COLUMN, JOINT_FIGURES, PERCENTILES, joint_column, percentile_header
 
 MAX_PRINTED_ROWS = 40
 
@@ -131,6 +131,11 @@ def rich_table(plan: SweepPlan, header: list[str], rows: list[dict]) -> WholeCel
         columns.append(Column(f"F max N\n{joint}",
                               [_number(row.get(joint_column("max_contact_force_N", joint))) for row in shown]))
         columns.append(Column(f"free imp cont %\n{joint}", [_shares(row, joint) for row in shown]))
+    if ENVELOPE_COLUMN in header:
+        travel = [("closing ms", "operating_time_ms"), ("zone m/s", "zone_speed_m_s"), ("overtravel mm", "overtravel_mm"),
+                  ("rebound mm", "rebound_mm")]
+        columns += [Column(title, [_number(row.get(key), 4) for row in shown]) for title, key in travel]
+        columns.append(Column("in envelope", [row.get(ENVELOPE_COLUMN) or "–" for row in shown], "left"))
     columns.append(Column("steps", [_number(row.get("steps")) for row in shown]))
     columns.append(Column("status", ["ok" if row["status"] == "complete" else row["status"] for row in shown], "left"))
     return WholeCellTable(keys, columns)

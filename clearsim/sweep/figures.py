@@ -33,6 +33,7 @@ class CaseRecord:
     rejected_steps: int = 0
     wall_time: float = NAN
     warnings: str = ""  # the result file's `warnings` attribute
+    travel: dict = field(default_factory=dict)  # the `travel_figures` attribute (clearsim.travel), SI; {} without
 
 
 def _sensor(data: dict, name: str | None) -> np.ndarray | None:
@@ -52,7 +53,7 @@ def read_record(path: Path, output) -> CaseRecord:
         velocity=_sensor(data, output.velocity), displacement=_sensor(data, output.displacement),
         peak_acceleration=summary.peak_acceleration[1] if summary.peak_acceleration else NAN,
         contact=contact, steps=int(attrs.get("steps", 0)), rejected_steps=int(attrs.get("rejected_steps", 0)),
-        wall_time=float(attrs.get("wall_time_s", NAN)), warnings=" ".join(summary.warnings))
+        wall_time=float(attrs.get("wall_time_s", NAN)), warnings=" ".join(summary.warnings), travel=summary.travel)
 
 
 def start_time(time: np.ndarray, velocity: np.ndarray, threshold: float, sign: float) -> float:

@@ -17,6 +17,10 @@ PERCENTILES_FILE = "percentiles.csv"
 PERCENTILES = (5, 25, 50, 75, 95)
 FIGURES = ("peak_acceleration_m_s2", "acceleration_ratio", "start_delay_ms", "end_error_percent")
 JOINT_FIGURES = ("max_contact_force_N", "free_percent", "impact_percent", "contact_percent")
+# summary column → (`travel_figures` key, scale from SI): the travel figures of a mechanism with a `travel:` block
+TRAVEL_FIGURES = {"operating_time_ms": ("operating_time_s", 1e3), "zone_speed_m_s": ("zone_speed_m_per_s", 1.0),
+                  "overtravel_mm": ("overtravel_m", 1e3), "rebound_mm": ("rebound_m", 1e3)}
+ENVELOPE_COLUMN = "inside_envelope"
 TAIL = ("steps", "rejected_steps", "wall_time_s", "reused", "error", "warnings")
 
 
@@ -29,9 +33,24 @@ def clearance_joints(outcomes: dict[str, CaseOutcome]) -> list[str]:
     return list(dict.fromkeys(joints))
 
 
-def columns(plan: SweepPlan, joints: list[str]) -> list[str]:
+def has_travel(outcomes: dict[str, CaseOutcome]) -> bool:
+    """Whether any case's result has travel figures (its mechanism a `travel:` block)."""
+    return any(o.record is not None and o.record.travel for o in outcomes.values())
+
+
+def columns(plan: SweepPlan, joints: list[str], travel: bool = False) -> list[str]:
     per_joint = [joint_column(f, j) for j in joints for f in JOINT_FIGURES]
-    return ["case", "reference", *plan.labels, "status", *FIGURES, *per_joint, *TAIL]
+    travel_columns = [*TRAVEL_FIGURES, ENVELOPE_COLUMN] if travel else []
+    return ["case", "reference", *plan.labels, "status", *FIGURES, *per_joint, *travel_columns, *TAIL]
+
+
+def _travel_cells(travel: dict) -> dict:
+    """The travel figures in the summary's units (NaN: not reached), and whether the curve kept to its envelope
+    (yes / no; blank without an envelope or when the run ended before it began)."""
+    cells = {column: math.nan if travel.get(key) is None else travel[key] * scale
+             for column, (key, scale) in TRAVEL_FIGURES.items()}
+    inside = travel.get("inside_envelope")
+    return cells | {ENVELOPE_COLUMN: "" if inside is None else "yes" if inside else "no"}
 
 
 def _joint_cells(record: CaseRecord, joints: list[str]) -> dict:
@@ -61,12 +80,13 @@ def case_row(plan: SweepPlan, name: str, outcomes: dict[str, CaseOutcome], joint
         row["peak_acceleration_m_s2"] = record.peak_acceleration
         row.update(relative_figures(record, ideal, plan.delay_fraction))
         row.update(_joint_cells(record, joints))
+        row.update(_travel_cells(record.travel) if record.travel else {})
     return row
 
 
 def summary_rows(plan: SweepPlan, outcomes: dict[str, CaseOutcome]) -> tuple[list[str], list[dict]]:
     joints = clearance_joints(outcomes)
-    return columns(plan, joints), [case_row(plan, case.name, outcomes, joints) for case in plan.cases]
+    return columns(plan, joints, has_travel(outcomes)), [case_row(plan, case.name, outcomes, joints) for case in plan.cases]
 
 
 def _cell(value) -> str:
@@ -85,7 +105,7 @@ def write_csv(path: Path, header: list[str], rows: list[dict]) -> Path:
 
 def percentiles(plan: SweepPlan, header: list[str], rows: list[dict]) -> list[dict]:
     """Per figure of merit, over the complete non-ideal cases: count and percentiles."""
-    figures = [key for key in header if key in FIGURES or key.split("[")[0] in JOINT_FIGURES]
+    figures = [key for key in header if key in FIGURES or key in TRAVEL_FIGURES or key.split("[")[0] in JOINT_FIGURES]
     sampled = [row for row in rows if not plan.case(row["case"]).ideal and row.get("status") == "complete"]
     table = []
     for figure in figures:

@@ -165,15 +165,18 @@ def envelope_check(time: np.ndarray, travel: np.ndarray, lower, upper) -> dict[s
             "envelope_largest_excursion_at_s": float(knots[largest])}
 
 
-def envelope_verdict(figures: dict) -> str:
-    """The envelope check of a `travel_figures` record in words, with the first exit and the largest excursion."""
+def envelope_rows(figures: dict) -> list[tuple[str, str]]:
+    """The envelope check of a `travel_figures` record as (label, value) rows: inside or not, and if not where the
+    curve first leaves the envelope and its largest excursion beyond a limit."""
     inside = figures["inside_envelope"]
     if inside is None:
-        return "not checked: the run ends before the envelope begins"
+        return [("within the envelope", "not checked: the run ends before it begins")]
     if inside:
-        return "yes"
-    return (f"no: leaves it at {figures['envelope_first_outside_s'] * 1e3:.4g} ms, largest excursion "
-            f"{figures['envelope_largest_excursion_m'] * 1e3:.4g} mm at {figures['envelope_largest_excursion_at_s'] * 1e3:.4g} ms")
+        return [("within the envelope", "yes")]
+    return [("within the envelope", "no"),
+            ("leaves the envelope at", f"{figures['envelope_first_outside_s'] * 1e3:.4g} ms"),
+            ("largest excursion", f"{figures['envelope_largest_excursion_m'] * 1e3:.4g} mm at "
+                                  f"{figures['envelope_largest_excursion_at_s'] * 1e3:.4g} ms")]
 
 
 # figure of a `travel_figures` record → its label and how it is shown (SI value × scale, unit)
@@ -188,6 +191,4 @@ def figure_rows(figures: dict) -> list[tuple[str, str]]:
     travel never crossed), and the envelope verdict when an envelope was given."""
     rows = [(label, "not reached" if figures[key] is None else f"{figures[key] * scale:.4g} {unit}")
             for key, (label, scale, unit) in FIGURE_ROWS.items() if key in figures]
-    if "inside_envelope" in figures:
-        rows.append(("within the envelope", envelope_verdict(figures)))
-    return rows
+    return rows + (envelope_rows(figures) if "inside_envelope" in figures else [])

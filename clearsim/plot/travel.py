@@ -2,7 +2,7 @@
 
 The `travel:` sensor's travel against time, one line per run, inside the tolerance envelope (shaded) when the file
 gives one; the contact-touch and speed-zone positions as horizontal marks, the contact-touch time of each run as a
-dot; the figures of the result file's `travel_figures` attribute in a text box.
+dot; the figures of the result file's `travel_figures` attribute in a text box (their ranges for many runs).
 """
 
 from __future__ import annotations
@@ -14,10 +14,11 @@ import numpy as np
 from clearsim.plot.data import RunData
 from clearsim.plot.scales import TIME, length_scale
 from clearsim.plot.style import LEGEND_WIDTH, legend_beside, new_figure, run_style, set_title, title_of
-from clearsim.travel import figure_rows, limit_band
+from clearsim.travel import FIGURE_ROWS, figure_rows, limit_band
 
 ENVELOPE_COLOUR = "tab:green"
 MARK_COLOUR = "dimgray"
+LISTED_RUNS = 3  # overlaid runs whose figures the text box lists one by one; more are summarised as ranges
 
 
 def travel_figures_of(run: RunData) -> dict:
@@ -31,7 +32,24 @@ def travel_runs(runs: list[RunData]) -> list[RunData]:
             and run.mechanism.travel is not None and run.has(f"sensors/{run.mechanism.travel.sensor}")]
 
 
+def _ranges_text(runs: list[RunData]) -> str:
+    """Each figure's range over the runs (those that reach it), and how many runs kept to the envelope."""
+    records = [travel_figures_of(run) for run in runs]
+    lines = [f"{len(runs)} runs"]
+    for key, (label, scale, unit) in FIGURE_ROWS.items():
+        values = [record[key] * scale for record in records if record.get(key) is not None]
+        if values:
+            lines.append(f"{label}: {min(values):.4g} to {max(values):.4g} {unit}")
+    checked = [record["inside_envelope"] for record in records if record.get("inside_envelope") is not None]
+    if checked:
+        lines.append(f"within the envelope: {sum(checked)} of {len(checked)}")
+    return "\n".join(lines)
+
+
 def _figures_text(runs: list[RunData]) -> str:
+    """The summary's travel rows of each run, or for more than LISTED_RUNS runs their ranges."""
+    if len(runs) > LISTED_RUNS:
+        return _ranges_text(runs)
     blocks = []
     for run in runs:
         rows = [f"{label}: {value}" for label, value in figure_rows(travel_figures_of(run))]

@@ -59,3 +59,20 @@ def test_the_travel_page_is_written_by_its_name(travel_run, tmp_path):
 def test_a_run_without_a_travel_block_has_no_travel_page(runs):
     figures, _ = build_figures([load_run(runs["clearance"])], PlotRequest([runs["clearance"]]))
     assert "travel" not in figures
+
+
+def test_many_overlaid_runs_have_their_figures_as_ranges(travel_run, tmp_path):
+    """Four runs of the same file: the text box gives each figure's range and the count within the envelope, not
+    four blocks of rows."""
+    copies = []
+    for number in range(4):
+        copies.append(tmp_path / f"copy{number}.h5")
+        copies[-1].write_bytes(travel_run.read_bytes())
+    figures, _ = build_figures([load_run(path) for path in copies], PlotRequest(copies))
+    ax = figures["travel"].axes[0]
+    text = next(t for t in ax.texts if t.get_gid() == "travel-figures").get_text()
+    with h5py.File(travel_run) as f:
+        touch = json.loads(f.attrs["travel_figures"])["operating_time_s"] * 1e3
+    assert text.startswith("4 runs") and f"time to contact touch: {touch:.4g} to {touch:.4g} ms" in text
+    assert "within the envelope: 4 of 4" in text and text.count("overtravel") == 1
+    assert len([line for line in ax.lines if line.get_label().startswith("copy")]) == 4

@@ -5,12 +5,14 @@ stores them; no such columns without the block."""
 import csv
 import json
 from pathlib import Path
+from types import SimpleNamespace
 
 import h5py
 import pytest
 from typer.testing import CliRunner
 
 from clearsim.cli import app
+from clearsim.sweep.summary import columns, percentiles
 
 SLIDER_CRANK = Path(__file__).resolve().parents[2] / "clearsim" / "configs" / "slider_crank_flores.yaml"
 SHORT = "solver.t_end=3ms"
@@ -52,3 +54,15 @@ def test_each_case_shows_its_travel_figures_and_whether_it_kept_to_the_envelope(
 def test_a_mechanism_without_a_travel_block_has_no_travel_columns(tmp_path):
     _, output, rows = sweep(tmp_path, SLIDER_CRANK, "plain")
     assert not {*COLUMNS, "inside_envelope"} & set(rows[0]) and "closing" not in output
+
+
+def test_monte_carlo_percentiles_cover_the_travel_figures():
+    plan = SimpleNamespace(labels=[], case=lambda name: SimpleNamespace(ideal=name == "ideal"))
+    header = columns(plan, [], travel=True)
+    times = [60.0, 61.0, 62.0, 63.0, 64.0]
+    rows = [{"case": "ideal", "status": "complete", "operating_time_ms": 0.0}]
+    rows += [{"case": f"sample-{k}", "status": "complete", "operating_time_ms": t, "inside_envelope": "yes"}
+             for k, t in enumerate(times)]
+    entries = {entry["figure"]: entry for entry in percentiles(plan, header, rows)}
+    assert entries["operating_time_ms"]["cases"] == 5 and entries["operating_time_ms"]["p50"] == 62.0
+    assert entries["operating_time_ms"]["p25"] == 61.0 and "inside_envelope" not in entries

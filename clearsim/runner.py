@@ -17,7 +17,7 @@ from typing import Callable
 
 import numpy as np
 
-from clearsim.assembly.arrays import CL_CLEARANCE
+from clearsim.assembly.arrays import CL_CLEARANCE, CL_STIFFNESS
 from clearsim.assembly.build import BuildError
 from clearsim.assembly.system import System, assemble
 from clearsim.errors import ClearsimError, InputError, SolverError, format_path
@@ -29,6 +29,7 @@ from clearsim.io.hdf5 import (
 from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
 from clearsim.model.flexible import flexible_link_names
 from clearsim.model.modes import flexible_modes_attribute, mode_lines
+from clearsim.physics.cylindrical import range_warnings
 from clearsim.solver.outputs import (
     classify_episodes, chunk_outputs, full_precision, output_rate, sample_modes, stored_outputs,
 )
@@ -213,7 +214,8 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                         status, complete = f"failed: {error}", False
                 # whatever failed above, the file is flagged as far as it can still be written
                 whirls = pending.whirls()
-                warnings = run.warnings() + whirl_warnings(whirls) if run is not None else []
+                warnings = run.warnings() + whirl_warnings(whirls) + pending.law_range_warnings() \
+                    if run is not None else []
                 final = _final_attributes(run, warnings) | _mode_attributes(system, loaded, run, whirls) \
                     | _travel_attributes(system, writer) if run is not None else {}
                 readable = writer.finish(complete, status, final)
@@ -314,6 +316,17 @@ class _PendingChunks:
                                             chunk.states, chunk.contact[:, :, [C_ECC_X, C_ECC_Y]]))
         self.items.clear()
         self.written_at = time.perf_counter()
+
+    def law_range_warnings(self) -> list[str]:
+        """Each clearance joint's elastic law used outside its range, at the deepest penetration sampled
+        (cylindrical.range_warnings)."""
+        arrays = self.system.arrays
+        clearance = arrays.clearance_params[:, CL_CLEARANCE]
+        peaks = ((np.concatenate(self.paths)[:, :, 2].max(axis=0) - 1.0) * clearance if self.paths
+                 else np.full(len(clearance), np.nan))
+        return [text for k, joint in enumerate(self.system.clearance_joints)
+                for text in range_warnings(joint, arrays.clearance_laws[k, 3], clearance[k],
+                                           arrays.clearance_params[k, CL_STIFFNESS], peaks[k])]
 
     def whirls(self) -> dict[str, list]:
         """The whirls of each clearance joint in the samples written (clearsim.whirl)."""

@@ -30,8 +30,8 @@ CL_JOURNAL_POINT = 2  # 2, 3: journal centre in the journal body's frame
 CL_BEARING_RADIUS = 4
 CL_JOURNAL_RADIUS = 5
 CL_CLEARANCE = 6
-CL_STIFFNESS = 7
-CL_EXPONENT = 8
+CL_STIFFNESS = 7  # the elastic law's scale: K (N/m^n) of a power law, S = π L E* (N/m) of a cylindrical law
+CL_EXPONENT = 8  # n of a power law (1, unused, for the others)
 CL_RESTITUTION = 9
 CL_MIN_IMPACT_SPEED = 10
 CL_MU_S = 11
@@ -39,6 +39,9 @@ CL_MU_D = 12
 CL_V_LOW = 13
 CL_V_HIGH = 14
 CLEARANCE_COLUMNS = 15
+# columns of clearance_laws: damping law (contact.CONTACT_LAWS), friction law, stick treatment, elastic law
+# (cylindrical.ELASTIC_LAWS)
+CLEARANCE_LAW_COLUMNS = 4
 
 # columns of offset_params
 OFF_POINT_I = 0  # 0, 1

@@ -5,7 +5,7 @@ journal centre P_J on the second; eccentricity e = P_J − P_B, n = e/|e|, penet
 penetration rate δ̇ = ė·n, tangent t = (−n_y, n_x) and sliding velocity
 v_t = ė·t + ω_J R_J − ω_B R_B (material points of journal and bearing at the contact).
 Forces act on the journal at P_J + R_J n:  −F_n n − μ(v_t) F_n t, and the opposite on the bearing
-at P_B + R_B n. Dissipated powers (F_n − K δⁿ) δ̇ and μ(v_t) F_n v_t are returned for the energy balance.
+at P_B + R_B n. Dissipated powers (F_n − F_el(δ)) δ̇ and μ(v_t) F_n v_t are returned for the energy balance.
 """
 
 from __future__ import annotations
@@ -23,7 +23,8 @@ from clearsim.assembly.kinematics import (
     point_position, point_velocity,
 )
 from clearsim.assembly.constraints import prescribed
-from clearsim.physics.contact import elastic_energy, elastic_force, normal_force
+from clearsim.physics.contact import damped_force
+from clearsim.physics.cylindrical import law_energy, law_force
 from clearsim.physics.friction import STICK_EXACT, friction_coefficient, sliding_coefficient
 
 # modes of a clearance joint, constant within a step. CONTACT is any contact of a smooth friction
@@ -101,13 +102,13 @@ def stick_row(system, k, q, qd):
 
 @njit(cache=True)
 def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact_speed):
-    """(F_n, F_t, K δⁿ) of clearance joint k; zero in free flight. F_t is the signed force along t."""
+    """(F_n, F_t, F_el(δ)) of clearance joint k; zero in free flight. F_t is the signed force along t."""
     if mode == FREE or penetration <= 0.0:
         return 0.0, 0.0, 0.0
     p = system.clearance_params[k]
     guarded_speed = max(impact_speed, p[CL_MIN_IMPACT_SPEED])  # grazing guard, docs/model.md
-    force = normal_force(system.clearance_laws[k, 0], penetration, rate, guarded_speed,
-                         p[CL_STIFFNESS], p[CL_EXPONENT], p[CL_RESTITUTION])
+    elastic = law_force(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT], p[CL_CLEARANCE])
+    force = damped_force(system.clearance_laws[k, 0], elastic, rate, guarded_speed, p[CL_RESTITUTION])
     law = system.clearance_laws[k, 1]
     if not exact_stick(system, k):
         mu = friction_coefficient(law, sliding, p[CL_MU_S], p[CL_MU_D], p[CL_V_LOW], p[CL_V_HIGH])
@@ -116,7 +117,7 @@ def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact
     else:
         direction = -1.0 if mode == SLIDE_BACK else 1.0
         mu = direction * sliding_coefficient(law, abs(sliding), p[CL_MU_S], p[CL_MU_D], p[CL_V_LOW], p[CL_V_HIGH])
-    return force, -mu * force, elastic_force(penetration, p[CL_STIFFNESS], p[CL_EXPONENT])
+    return force, -mu * force, elastic
 
 
 @njit(cache=True)
@@ -191,7 +192,7 @@ def spring_state(system, k, q, qd):
 
 @njit(cache=True)
 def potential_energy(system, q):
-    """Gravity + spring (elastic and preload) + contact elastic energy K δⁿ⁺¹/(n+1)."""
+    """Gravity + spring (elastic and preload) + contact elastic energy ∫₀^δ F_el (K δⁿ⁺¹/(n+1) for the power laws)."""
     energy = 0.0
     for b in range(system.mass.shape[0]):
         energy -= system.mass[b] * (system.gravity[0] * q[3 * b] + system.gravity[1] * q[3 * b + 1])
@@ -205,5 +206,6 @@ def potential_energy(system, q):
     for k in range(system.clearance_bodies.shape[0]):
         penetration = clearance_kinematics(system, k, q, zero)[4]
         p = system.clearance_params[k]
-        energy += elastic_energy(penetration, p[CL_STIFFNESS], p[CL_EXPONENT])
+        energy += law_energy(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT],
+                             p[CL_CLEARANCE])
     return energy

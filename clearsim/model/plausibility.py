@@ -105,7 +105,7 @@ def _clearance_ratio(parameters, path: tuple) -> list[Problem]:
 
 
 def _contact_stiffness(joint, defaults, parameters, path: tuple) -> list[Problem]:
-    if not math.isclose(parameters.exponent, 1.5):
+    if parameters.elastic != "point_hertz" or not math.isclose(parameters.exponent, 1.5):
         return []
     material = joint.material or defaults.material
     hertz = auto_stiffness(parameters.bearing_radius, parameters.journal_radius, material)

@@ -51,6 +51,8 @@ class ClearanceParameters:
     stick: str  # "exact" (a constraint while sticking) or "smooth" (the law as written)
     initial_eccentricity: tuple[float, float] = (0.0, 0.0)  # m, journal centre − bearing centre, t = 0
     initial_velocity: tuple[float, float] = (0.0, 0.0)  # m/s, its rate at t = 0
+    elastic: str = "point_hertz"  # the elastic law (clearsim.physics.cylindrical); stiffness, exponent are its K, n
+    length: float = 0.0  # m, the pin's axial length L (0: not given)
 
 
 def is_clearance_joint(joint) -> bool:
@@ -69,11 +71,13 @@ def resolve_clearance(joint, defaults: Defaults) -> ClearanceParameters | None:
     contact, contact_origin = _merged_contact(joint, defaults)
     friction, friction_origin = _merged_friction(joint, defaults)
     _check_friction(friction, friction_origin)
-    stiffness = _stiffness(contact, contact_origin, bearing, journal, joint.material or defaults.material)
+    stiffness, exponent = _elastic_coefficients(contact, contact_origin, bearing, journal, clearance,
+                                                joint.material or defaults.material)
     return ClearanceParameters(
         bearing_radius=bearing, journal_radius=journal, clearance=clearance,
-        law=contact["law"], restitution=contact["restitution"], exponent=contact["exponent"],
+        law=contact["law"], restitution=contact["restitution"], exponent=exponent,
         stiffness=stiffness, min_impact_speed=contact["min_impact_speed"],
+        elastic=contact["elastic"], length=contact.get("length", 0.0),
         friction_law=friction["law"], **_friction_numbers(friction),
         initial_eccentricity=_initial_eccentricity(joint, clearance),
         initial_velocity=tuple(map(float, getattr(joint, "initial_velocity", None) or (0.0, 0.0))),
@@ -227,9 +231,35 @@ def _friction_numbers(friction: dict) -> dict:
 # --- contact stiffness ----------------------------------------------------------------------------
 
 
+def _elastic_coefficients(contact: dict, origin: dict, bearing: float, journal: float, clearance: float,
+                          material) -> tuple[float, float]:
+    """(K, n) the elastic law reads (clearsim.physics.cylindrical): the file's stiffness and exponent for
+    point_hertz; for a cylindrical law, from the pin's length, the clearance and the material."""
+    from clearsim.physics.cylindrical import effective_modulus, pereira_coefficients
+
+    elastic = contact["elastic"]
+    if elastic == "point_hertz":
+        return _stiffness(contact, origin, bearing, journal, material), contact["exponent"]
+    if "length" not in contact:
+        raise _error_at(origin, "elastic", f"the elastic law '{elastic}' needs the pin's axial length",
+                        "add `length: 50 mm` to the joint's contact or to defaults.contact", "contact")
+    written = {"stiffness": not _is_auto(contact["stiffness"]),
+               "exponent": not math.isclose(contact["exponent"], AUTO_STIFFNESS_EXPONENT)}
+    for name in written:
+        if origin.get(name) is not None and written[name]:
+            raise _error_at(origin, name, f"`{name}` belongs to the point_hertz law; the '{elastic}' law takes its "
+                            "stiffness from the length, the clearance and the material",
+                            f"remove `{name}`, or choose `elastic: point_hertz`", "contact")
+    modulus = effective_modulus(material.youngs_modulus, material.poisson_ratio, material.youngs_modulus,
+                                material.poisson_ratio)
+    if elastic == "pereira":
+        return pereira_coefficients(clearance, contact["length"], modulus)
+    return math.pi * contact["length"] * modulus, 1.0  # S = π L E*; the exponent is not used
+
+
 def _stiffness(contact: dict, origin: dict, bearing: float, journal: float, material) -> float:
     value, exponent = contact["stiffness"], contact["exponent"]
-    if isinstance(value, str) and value.strip().lower() == "auto":
+    if _is_auto(value):
         if not math.isclose(exponent, AUTO_STIFFNESS_EXPONENT):
             raise _error_at(origin, "exponent", f"`stiffness: auto` is the Hertz value for exponent 1.5, "
                             f"not {exponent:g}", f"give the stiffness in N/m^{exponent:g}", "contact")
@@ -241,6 +271,10 @@ def _stiffness(contact: dict, origin: dict, bearing: float, journal: float, mate
     if stiffness <= 0.0:
         raise _error_at(origin, "stiffness", f"the contact stiffness must be positive, got {value!r}", None, "contact")
     return stiffness
+
+
+def _is_auto(stiffness) -> bool:
+    return isinstance(stiffness, str) and stiffness.strip().lower() == "auto"
 
 
 def auto_stiffness(bearing: float, journal: float, material) -> float:

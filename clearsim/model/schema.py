@@ -106,10 +106,16 @@ class ContactSpec(Strict):
     min_impact_speed: Speed | None = Field(
         None, gt=0.0, description="floor on the impact speed δ̇⁻ in the damping term (grazing guard)"
     )
+    elastic: Literal["point_hertz", "johnson", "esdu_78035", "pereira", "liu"] | None = Field(
+        None, description="elastic law F_el(δ) that the damping `law` multiplies: point_hertz (K δⁿ from `stiffness` "
+        "and `exponent`) or a cylindrical law of a pin of axial `length` (docs/model-contact.md)")
+    length: Length | None = Field(None, gt=0.0, description="axial length L of the pin in its bore (the cylindrical "
+                                  "`elastic` laws)")
 
 
 DEFAULT_CONTACT = ContactSpec(
-    law="lankarani_nikravesh", restitution=0.9, exponent=1.5, stiffness="auto", min_impact_speed=1e-3
+    law="lankarani_nikravesh", restitution=0.9, exponent=1.5, stiffness="auto", min_impact_speed=1e-3,
+    elastic="point_hertz",
 )
 
 

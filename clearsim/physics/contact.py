@@ -33,6 +33,7 @@ CONTACT_LAWS = {
 # ∫₀¹ dx / sqrt(1 − x^{5/2}) = (2/5) B(2/5, 1/2) ≈ 1.47164 (substitute u = x^{5/2});
 # the Hertz contact lasts twice the time to reach δ_max, so t_c = 2.94328 δ_max / v⁻.
 _HERTZ_HALF_TIME_INTEGRAL = 0.4 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)  # B(a, b) = Γ(a)Γ(b)/Γ(a + b)
+HERTZ_CONTACT_TIME_FACTOR = 2.0 * _HERTZ_HALF_TIME_INTEGRAL  # t_c = 2.94328 δ_max / v⁻
 
 
 @njit(cache=True, inline="always")
@@ -56,9 +57,15 @@ def normal_force(law, penetration, penetration_rate, impact_speed, stiffness, ex
     """F_n = K δⁿ (1 + D(c_e) δ̇/δ̇⁻) for δ > 0, else 0 (Meng 2015 eq. 11 with D = 3(1−c_e²)/4)."""
     if penetration <= 0.0:
         return 0.0
+    return damped_force(law, stiffness * penetration**exponent, penetration_rate, impact_speed, restitution)
+
+
+@njit(cache=True, inline="always")
+def damped_force(law, elastic, penetration_rate, impact_speed, restitution):
+    """F_n = F_el (1 + D(c_e) δ̇/δ̇⁻) of any elastic force F_el > 0 (clearsim.physics.cylindrical)."""
     damping = hysteresis_factor(law, restitution) * penetration_rate / impact_speed
     # On fast separation the damping term can exceed the elastic one; contact never pulls.
-    return max(0.0, stiffness * penetration**exponent * (1.0 + damping))
+    return max(0.0, elastic * (1.0 + damping))
 
 
 @njit(cache=True, inline="always")
@@ -121,4 +128,4 @@ def hertz_contact_time(effective_mass, stiffness, impact_speed, exponent=1.5):
     if exponent != 1.5:
         raise ValueError(f"closed-form contact time is for exponent 1.5, got {exponent}")
     max_penetration = hertz_max_penetration(effective_mass, stiffness, impact_speed, exponent)
-    return 2.0 * _HERTZ_HALF_TIME_INTEGRAL * max_penetration / impact_speed
+    return HERTZ_CONTACT_TIME_FACTOR * max_penetration / impact_speed

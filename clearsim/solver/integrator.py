@@ -44,7 +44,8 @@ from clearsim.assembly.dynamics import (
 from clearsim.assembly.forces import (
     CONTACT, FREE, SLIDE_BACK, STICK, clearance_kinematics, contact_force_magnitudes, exact_stick,
 )
-from clearsim.physics.contact import hertz_max_penetration
+from clearsim.physics.contact import HERTZ_CONTACT_TIME_FACTOR
+from clearsim.physics.cylindrical import PEREIRA, POINT_HERTZ, law_max_penetration
 from clearsim.physics.friction import static_coefficient
 from clearsim.solver.dopri import STAGES, error_norm, interpolate, step
 from clearsim.solver.samples import derive_sample
@@ -261,13 +262,18 @@ def emit_samples(system, dynamics, projection, t, y, stages, h, t_next, modes, s
 
 @njit(cache=True, inline="always")
 def contact_time_step(system, k, q, modes, speed):
-    """Initial step into contact: the Hertz contact time t_c = 3.218 (m/K)^(2/5) v^(−1/5), over 20."""
+    """Initial step into contact: the contact time over 20. Power laws: t_c = 3.218 (m/K)^(2/5) v^(−1/5) (Hertz);
+    cylindrical laws: 2.943 δ_max/v with δ_max from the law's own energy (clearsim.physics.cylindrical)."""
     mass = effective_mass(system, k, q, modes)
     stiffness = system.clearance_params[k, CL_STIFFNESS]
     exponent = system.clearance_params[k, CL_EXPONENT]
     v = max(speed, system.clearance_params[k, CL_MIN_IMPACT_SPEED])
     if not np.isfinite(mass):
         return np.inf, mass
+    law = system.clearance_laws[k, 3]
+    if law != POINT_HERTZ and law != PEREIRA:
+        depth = law_max_penetration(law, mass, v, stiffness, exponent, system.clearance_params[k, CL_CLEARANCE])
+        return HERTZ_CONTACT_TIME_FACTOR * depth / v / 20.0, mass
     # t_c ∝ (m/K)^(1/(n+1)) v^((1−n)/(n+1)); exact prefactor for n = 1.5, fine as a scale for any n
     t_c = 3.218 * (mass / stiffness) ** (1.0 / (exponent + 1.0)) * v ** ((1.0 - exponent) / (exponent + 1.0))
     return t_c / 20.0, mass
@@ -301,10 +307,11 @@ def settle_friction(system, dynamics, projection, k, t, y, modes, speeds, may_st
 
 @njit(cache=True, inline="always")
 def tolerance_over_penetration(system, k, y, mass, speed, rtol, atol):
-    """The error control's position tolerance at joint k's bodies over the Hertz penetration of the impact at its
-    onset: above 1 a step may err by more than the whole penetration, so the contact force is not resolved."""
+    """The error control's position tolerance at joint k's bodies over the undamped penetration of the impact at
+    its onset: above 1 a step may err by more than the whole penetration, so the contact force is not resolved."""
     p = system.clearance_params[k]
-    depth = hertz_max_penetration(mass, p[CL_STIFFNESS], max(speed, p[CL_MIN_IMPACT_SPEED]), p[CL_EXPONENT])
+    depth = law_max_penetration(system.clearance_laws[k, 3], mass, max(speed, p[CL_MIN_IMPACT_SPEED]),
+                                p[CL_STIFFNESS], p[CL_EXPONENT], p[CL_CLEARANCE])
     scale = 0.0
     for slot in range(2):
         body = system.clearance_bodies[k, slot]

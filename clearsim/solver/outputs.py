@@ -17,7 +17,8 @@ import math
 
 import numpy as np
 
-from clearsim.assembly.arrays import CL_EXPONENT, CL_MIN_IMPACT_SPEED, CL_STIFFNESS, OFF_DIRECTION
+from clearsim.assembly.arrays import CL_CLEARANCE, CL_EXPONENT, CL_MIN_IMPACT_SPEED, CL_STIFFNESS, OFF_DIRECTION
+from clearsim.physics.cylindrical import PEREIRA, POINT_HERTZ, law_max_penetration
 from clearsim.assembly.forces import STICK
 from clearsim.assembly.dynamics import WORK_APPLIED, WORK_CONTACT, WORK_DAMPING, WORK_DRIVER, WORK_FRICTION
 from clearsim.assembly.system import SensorSpec, System
@@ -115,11 +116,15 @@ def _rotate(angle, vectors):
 def hertz_durations(system: System, joints: np.ndarray, impact_speeds: np.ndarray,
                     effective_masses: np.ndarray) -> np.ndarray:
     """t_H = 2.943 δ_max/v (s) of an impact of each clearance joint at δ̇⁻ (at least its min_impact_speed) with its
-    effective mass."""
+    effective mass; δ_max of a cylindrical law from its own energy (cylindrical.law_max_penetration)."""
     params = system.arrays.clearance_params[joints]
     speed = np.maximum(impact_speeds, params[:, CL_MIN_IMPACT_SPEED])
     exponent = params[:, CL_EXPONENT]
     depth = (5.0 * effective_masses * speed**2 / (4.0 * params[:, CL_STIFFNESS])) ** (1.0 / (exponent + 1.0))
+    laws = system.arrays.clearance_laws[joints, 3]
+    for i in np.flatnonzero((laws != POINT_HERTZ) & (laws != PEREIRA)):
+        depth[i] = law_max_penetration(laws[i], effective_masses[i], speed[i], params[i, CL_STIFFNESS],
+                                       exponent[i], params[i, CL_CLEARANCE])
     return HERTZ_DURATION * depth / speed
 
 

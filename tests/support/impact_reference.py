@@ -12,7 +12,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
-from clearsim.physics.contact import hertz_max_penetration, normal_force
+from clearsim.physics.contact import damped_force, hertz_max_penetration, normal_force
+from clearsim.physics.cylindrical import law_force, law_max_penetration
 
 # Damped laws at low restitution leave the wall slowly (exit speed ≪ v⁻), so the
 # contact can last many Hertz times; the separation event ends the run long before.
@@ -84,3 +85,18 @@ def law_impact(law, restitution, stiffness=1.0e10, mass=1.0, impact_speed=1.0, e
 
     time_scale = hertz_max_penetration(mass, stiffness, impact_speed, exponent) / impact_speed
     return integrate_impact(force, mass, impact_speed, time_scale, rtol)
+
+
+def elastic_law_impact(damping_law, elastic_law, restitution, stiffness, exponent, clearance, mass=1.0,
+                       impact_speed=1.0, rtol=1e-12):
+    """One impact under damping law `damping_law` (CONTACT_LAWS code) times the elastic law `elastic_law`
+    (cylindrical.ELASTIC_LAWS code) with its K, n and ΔR, SI units."""
+
+    def force(penetration, penetration_rate):
+        if penetration <= 0.0:
+            return 0.0
+        elastic = law_force(elastic_law, penetration, stiffness, exponent, clearance)
+        return damped_force(damping_law, elastic, penetration_rate, impact_speed, restitution)
+
+    depth = law_max_penetration(elastic_law, mass, impact_speed, stiffness, exponent, clearance)
+    return integrate_impact(force, mass, impact_speed, depth / impact_speed, rtol)

@@ -110,13 +110,10 @@ def _normalised_load(depth, constant):
             hi = x
         else:
             lo = x
-        step = residual / (constant - 1.0 - math.log(x))
-        following = x - step
-        if not lo < following < hi:
-            following = 0.5 * (lo + hi)
+        following = x - residual / (constant - 1.0 - math.log(x))
         if abs(following - x) <= _RELATIVE_TOLERANCE * x:
             return following
-        x = following
+        x = following if lo < following < hi else 0.5 * (lo + hi)
     return x
 
 
@@ -124,7 +121,7 @@ def _normalised_load(depth, constant):
 def line_contact_force(penetration, line_stiffness, clearance, constant):
     """F(δ) of δ = (F/S)[ln(4 S ΔR/F) + c] (S = π L E* in N/m, ΔR in m, F in N), 0 for δ ≤ 0.
 
-    Johnson (Contact Mechanics 1985, §5.6, eq. 5.43 for a cylinder in a conforming groove; c = −1) and
+    Johnson (Contact Mechanics 1985, §5.6; c = −1) and
     ESDU-78035 (1978; c = +1), as quoted by Pereira et al. 2011 and Skrinjar et al. 2018. Solved for F by
     _normalised_load up to the edge δ_e = 8 ΔR e^(c−2) (line_contact_edge), a straight line of slope S beyond.
     Valid for a non-conformal line contact: small contact angle, F well below the edge load 4 S ΔR e^(c−2).
@@ -176,8 +173,7 @@ def liu_force(penetration, line_stiffness, clearance):
     """F = (S/2) δ √(δ/(2 (ΔR + δ))), S = π L E* (Liu, Zhang, Yang, Mech. Mach. Theory 42:183, 2007, an
     improved elastic foundation model fitted to finite elements; ladisk/DyS `_Fn_Liu_etal`). → S δ^1.5/(2√(2ΔR))
     (a point law of K = π L E*/(2√(2ΔR)), n = 1.5) for δ ≪ ΔR; → S δ/(2√2) (linear) for δ ≫ ΔR. The source
-    states no load range; its finite-element check covers clearances of 0.01–1 mm at loads up to a few kN per
-    mm of length."""
+    states no load range."""
     if penetration <= 0.0:
         return 0.0
     return 0.5 * line_stiffness * penetration * math.sqrt(penetration / (2.0 * (clearance + penetration)))
@@ -185,7 +181,7 @@ def liu_force(penetration, line_stiffness, clearance):
 
 @njit(cache=True)
 def liu_stiffness(penetration, line_stiffness, clearance):
-    """dF/dδ = (S/(4√2)) √δ (3 ΔR + 2 δ)/(ΔR + δ)^1.5: Bai & Zhao's (2012) nonlinear stiffness coefficient
+    """dF/dδ = (S/(4√2)) √δ (3 ΔR + 2 δ)/(ΔR + δ)^1.5: Bai & Zhao's (Int. J. Non-Linear Mech. 48, 2013) nonlinear stiffness coefficient
     K_n = (π E*/8) √(2 δ (3ΔR + 2δ)²/(ΔR + δ)³) times L."""
     if penetration <= 0.0:
         return 0.0

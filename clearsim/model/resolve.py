@@ -249,7 +249,8 @@ def _elastic_coefficients(contact: dict, origin: dict, bearing: float, journal: 
         if origin.get(name) is not None and written[name]:
             raise _error_at(origin, name, f"`{name}` belongs to the point_hertz law; the '{elastic}' law takes its "
                             "stiffness from the length, the clearance and the material",
-                            f"remove `{name}`, or choose `elastic: point_hertz`", "contact")
+                            f"remove `{name}` (or write `{name}: {'auto' if name == 'stiffness' else '1.5'}`), or "
+                            "choose `elastic: point_hertz`", "contact")
     modulus = effective_modulus(material.youngs_modulus, material.poisson_ratio, material.youngs_modulus,
                                 material.poisson_ratio)
     if elastic == "pereira":

@@ -24,7 +24,7 @@ from clearsim.assembly.kinematics import (
 )
 from clearsim.assembly.constraints import prescribed
 from clearsim.physics.contact import damped_force
-from clearsim.physics.cylindrical import law_energy, law_force
+from clearsim.physics.cylindrical import law_state
 from clearsim.physics.friction import STICK_EXACT, friction_coefficient, sliding_coefficient
 
 # modes of a clearance joint, constant within a step. CONTACT is any contact of a smooth friction
@@ -107,7 +107,8 @@ def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact
         return 0.0, 0.0, 0.0
     p = system.clearance_params[k]
     guarded_speed = max(impact_speed, p[CL_MIN_IMPACT_SPEED])  # grazing guard, docs/model.md
-    elastic = law_force(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT], p[CL_CLEARANCE])
+    elastic = law_state(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT],
+                        p[CL_CLEARANCE])[0]
     force = damped_force(system.clearance_laws[k, 0], elastic, rate, guarded_speed, p[CL_RESTITUTION])
     law = system.clearance_laws[k, 1]
     if not exact_stick(system, k):
@@ -206,6 +207,6 @@ def potential_energy(system, q):
     for k in range(system.clearance_bodies.shape[0]):
         penetration = clearance_kinematics(system, k, q, zero)[4]
         p = system.clearance_params[k]
-        energy += law_energy(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT],
-                             p[CL_CLEARANCE])
+        energy += law_state(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT],
+                            p[CL_CLEARANCE])[2]
     return energy

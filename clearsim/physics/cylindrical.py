@@ -7,7 +7,7 @@ per joint: K (the law's scale), n (its exponent, power laws only) and the radial
 
   point_hertz  F = K δⁿ                          K, n: `stiffness`/`exponent` (sphere-Hertz K for `auto`)
   pereira      F = K δⁿ                          K, n from ΔR, L, E* (pereira_coefficients)
-  johnson      δ = (F/S) [ln(4 S ΔR / F) − 1]    S = π L E*, implicit in δ (line_contact_force)
+  johnson      δ = (F/S) [ln(4 S ΔR / F) − 1]    S = π L E*, implicit in δ (line_contact_state)
   esdu_78035   δ = (F/S) [ln(4 S ΔR / F) + 1]    S = π L E*, implicit in δ
   liu          F = (S/2) δ √(δ / (2 (ΔR + δ)))   S = π L E*
 
@@ -118,51 +118,25 @@ def _normalised_load(depth, constant):
 
 
 @njit(cache=True)
-def line_contact_force(penetration, line_stiffness, clearance, constant):
-    """F(δ) of δ = (F/S)[ln(4 S ΔR/F) + c] (S = π L E* in N/m, ΔR in m, F in N), 0 for δ ≤ 0.
+def line_contact_state(penetration, line_stiffness, clearance, constant):
+    """(F, dF/dδ, ∫₀^δ F) of δ = (F/S)[ln(4 S ΔR/F) + c] (S = π L E* in N/m, ΔR in m, F in N) at δ > 0.
 
-    Johnson (Contact Mechanics 1985, §5.6; c = −1) and
-    ESDU-78035 (1978; c = +1), as quoted by Pereira et al. 2011 and Skrinjar et al. 2018. Solved for F by
-    _normalised_load up to the edge δ_e = 8 ΔR e^(c−2) (line_contact_edge), a straight line of slope S beyond.
-    Valid for a non-conformal line contact: small contact angle, F well below the edge load 4 S ΔR e^(c−2).
+    Johnson (Contact Mechanics 1985, §5.6; c = −1) and ESDU-78035 (1978; c = +1), as quoted by Pereira et al.
+    2011 and Skrinjar et al. 2018. F solved by _normalised_load up to the edge δ_e = 8 ΔR e^(c−2)
+    (line_contact_edge), a straight line of slope S beyond. dF/dδ = S/(ln(4 S ΔR/F) + c − 1): → 0 (as S/ln(1/F))
+    at small load, S at the edge and beyond. ∫F = F δ − ∫₀^F δ(f) df = (F²/2S)(ln(4 S ΔR/F) + c − ½) up to the
+    edge, plus the straight line's F_e (δ − δ_e) + S (δ − δ_e)²/2 beyond. Valid for a non-conformal line contact:
+    small contact angle, F well below the edge load 4 S ΔR e^(c−2).
     """
-    if penetration <= 0.0:
-        return 0.0
     reference = 4.0 * line_stiffness * clearance
     edge = line_contact_edge(constant)
-    depth = penetration / (4.0 * clearance)
-    if depth <= 2.0 * edge:
-        return reference * _normalised_load(depth, constant)
-    return reference * edge + line_stiffness * (penetration - 8.0 * clearance * edge)
-
-
-@njit(cache=True)
-def line_contact_stiffness(penetration, line_stiffness, clearance, constant):
-    """dF/dδ = S / (ln(4 S ΔR/F) + c − 1): → 0 (as S/ln(1/F)) at small load, S at the edge and beyond."""
-    if penetration <= 0.0:
-        return 0.0
-    depth = penetration / (4.0 * clearance)
-    edge = line_contact_edge(constant)
-    if depth >= 2.0 * edge:
-        return line_stiffness
-    return line_stiffness / (constant - 1.0 - math.log(_normalised_load(depth, constant)))
-
-
-@njit(cache=True)
-def line_contact_energy(penetration, line_stiffness, clearance, constant):
-    """∫₀^δ F = F δ − ∫₀^F δ(f) df = (F²/2S)(ln(4 S ΔR/F) + c − ½) up to the edge; plus the straight line's
-    F_e (δ − δ_e) + S (δ − δ_e)²/2 beyond."""
-    if penetration <= 0.0:
-        return 0.0
-    reference = 4.0 * line_stiffness * clearance
-    edge = line_contact_edge(constant)
-    depth = penetration / (4.0 * clearance)
-    x = _normalised_load(min(depth, 2.0 * edge), constant)
-    energy = (reference * x) ** 2 / (2.0 * line_stiffness) * (constant - 0.5 - math.log(x))
+    x = _normalised_load(min(penetration / (4.0 * clearance), 2.0 * edge), constant)
+    force = reference * x
+    energy = force * force / (2.0 * line_stiffness) * (constant - 0.5 - math.log(x))
     beyond = penetration - 8.0 * clearance * edge
-    if beyond > 0.0:
-        energy += reference * edge * beyond + 0.5 * line_stiffness * beyond * beyond
-    return energy
+    if beyond <= 0.0:
+        return force, line_stiffness / (constant - 1.0 - math.log(x)), energy
+    return force + line_stiffness * beyond, line_stiffness, energy + force * beyond + 0.5 * line_stiffness * beyond**2
 
 
 # --- Liu et al. 2007: elastic foundation for a conformal cylindrical contact -----------------------------------
@@ -173,18 +147,14 @@ def liu_force(penetration, line_stiffness, clearance):
     """F = (S/2) δ √(δ/(2 (ΔR + δ))), S = π L E* (Liu, Zhang, Yang, Mech. Mach. Theory 42:183, 2007, an
     improved elastic foundation model fitted to finite elements; ladisk/DyS `_Fn_Liu_etal`). → S δ^1.5/(2√(2ΔR))
     (a point law of K = π L E*/(2√(2ΔR)), n = 1.5) for δ ≪ ΔR; → S δ/(2√2) (linear) for δ ≫ ΔR. The source
-    states no load range."""
-    if penetration <= 0.0:
-        return 0.0
+    states no load range. δ > 0."""
     return 0.5 * line_stiffness * penetration * math.sqrt(penetration / (2.0 * (clearance + penetration)))
 
 
 @njit(cache=True)
 def liu_stiffness(penetration, line_stiffness, clearance):
-    """dF/dδ = (S/(4√2)) √δ (3 ΔR + 2 δ)/(ΔR + δ)^1.5: Bai & Zhao's (Int. J. Non-Linear Mech. 48, 2013) nonlinear stiffness coefficient
-    K_n = (π E*/8) √(2 δ (3ΔR + 2δ)²/(ΔR + δ)³) times L."""
-    if penetration <= 0.0:
-        return 0.0
+    """dF/dδ = (S/(4√2)) √δ (3 ΔR + 2 δ)/(ΔR + δ)^1.5 at δ > 0: the nonlinear stiffness coefficient
+    K_n = (π E*/8) √(2 δ (3ΔR + 2δ)²/(ΔR + δ)³) of Bai & Zhao (Int. J. Non-Linear Mech. 48, 2013) times L."""
     return (line_stiffness / (4.0 * math.sqrt(2.0)) * math.sqrt(penetration) * (3.0 * clearance + 2.0 * penetration)
             / (clearance + penetration) ** 1.5)
 
@@ -192,9 +162,8 @@ def liu_stiffness(penetration, line_stiffness, clearance):
 @njit(cache=True)
 def liu_energy(penetration, line_stiffness, clearance):
     """∫₀^δ (S/(2√2)) s^1.5 (ΔR + s)^−0.5 ds. Closed form ((2δ − 3ΔR)/4) √(δ(ΔR+δ)) + (3ΔR²/4) asinh(√(δ/ΔR))
-    for δ ≥ ΔR/4; below, where its terms cancel, the binomial series Σ C(−½, k) ΔR^(−½−k) δ^(k+5/2)/(k + 5/2)."""
-    if penetration <= 0.0:
-        return 0.0
+    for δ ≥ ΔR/4; below, where its terms cancel, the binomial series Σ C(−½, k) ΔR^(−½−k) δ^(k+5/2)/(k + 5/2).
+    δ > 0."""
     scale = line_stiffness / (2.0 * math.sqrt(2.0))
     ratio = penetration / clearance
     if ratio >= 0.25:
@@ -216,35 +185,18 @@ def liu_energy(penetration, line_stiffness, clearance):
 
 
 @njit(cache=True)
-def law_force(law, penetration, stiffness, exponent, clearance):
-    """F_el(δ) of elastic law `law` (ELASTIC_LAWS) with the joint's K, n, ΔR (module docstring)."""
-    if law == LIU:
-        return liu_force(penetration, stiffness, clearance)
-    if law == JOHNSON or law == ESDU_78035:
-        return line_contact_force(penetration, stiffness, clearance, line_contact_constant(law))
-    return power_force(penetration, stiffness, exponent)
-
-
-@njit(cache=True)
-def law_stiffness(law, penetration, stiffness, exponent, clearance):
-    """dF_el/dδ of elastic law `law`; n K δⁿ⁻¹ for the power laws."""
-    if law == LIU:
-        return liu_stiffness(penetration, stiffness, clearance)
-    if law == JOHNSON or law == ESDU_78035:
-        return line_contact_stiffness(penetration, stiffness, clearance, line_contact_constant(law))
+def law_state(law, penetration, stiffness, exponent, clearance):
+    """(F_el, dF_el/dδ, ∫₀^δ F_el) of elastic law `law` (ELASTIC_LAWS) with the joint's K, n, ΔR (module
+    docstring); zeros for δ ≤ 0. The power laws: K δⁿ, n K δⁿ⁻¹, K δⁿ⁺¹/(n + 1)."""
     if penetration <= 0.0:
-        return 0.0
-    return exponent * stiffness * penetration ** (exponent - 1.0)
-
-
-@njit(cache=True)
-def law_energy(law, penetration, stiffness, exponent, clearance):
-    """∫₀^δ F_el of elastic law `law` (J)."""
+        return 0.0, 0.0, 0.0
     if law == LIU:
-        return liu_energy(penetration, stiffness, clearance)
+        return (liu_force(penetration, stiffness, clearance), liu_stiffness(penetration, stiffness, clearance),
+                liu_energy(penetration, stiffness, clearance))
     if law == JOHNSON or law == ESDU_78035:
-        return line_contact_energy(penetration, stiffness, clearance, line_contact_constant(law))
-    return power_energy(penetration, stiffness, exponent)
+        return line_contact_state(penetration, stiffness, clearance, line_contact_constant(law))
+    return (power_force(penetration, stiffness, exponent), exponent * stiffness * penetration ** (exponent - 1.0),
+            power_energy(penetration, stiffness, exponent))
 
 
 @njit(cache=True)
@@ -258,11 +210,11 @@ def law_max_penetration(law, effective_mass, impact_speed, stiffness, exponent, 
     if not target < math.inf:
         return math.inf
     depth = clearance
-    while law_energy(law, depth, stiffness, exponent, clearance) < target:
+    while law_state(law, depth, stiffness, exponent, clearance)[2] < target:
         depth *= 2.0
     for _ in range(_NEWTON_ITERATIONS):
-        step = ((law_energy(law, depth, stiffness, exponent, clearance) - target)
-                / law_force(law, depth, stiffness, exponent, clearance))
+        force, _, energy = law_state(law, depth, stiffness, exponent, clearance)
+        step = (energy - target) / force
         depth -= step
         if abs(step) <= 1e-14 * depth:
             break

@@ -17,7 +17,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the script lives
 
 from clearsim.physics.contact import internal_contact_stiffness  # noqa: E402
 from clearsim.physics.cylindrical import (  # noqa: E402
-    ELASTIC_LAWS, ESDU_78035, JOHNSON, effective_modulus, law_force, law_stiffness, line_contact_constant,
+    ELASTIC_LAWS, ESDU_78035, JOHNSON, effective_modulus, law_state, line_contact_constant,
     line_contact_edge, pereira_coefficients,
 )
 
@@ -46,9 +46,9 @@ def coefficients():
 def penetration_at(law, stiffness, exponent, load):
     """δ where F_el(δ) = load (the laws rise monotonically)."""
     upper = CLEARANCE
-    while law_force(law, upper, stiffness, exponent, CLEARANCE) < load:
+    while law_state(law, upper, stiffness, exponent, CLEARANCE)[0] < load:
         upper *= 2.0
-    return brentq(lambda d: law_force(law, d, stiffness, exponent, CLEARANCE) - load, 0.0, upper, xtol=1e-18,
+    return brentq(lambda d: law_state(law, d, stiffness, exponent, CLEARANCE)[0] - load, 0.0, upper, xtol=1e-18,
                   rtol=1e-14)
 
 
@@ -63,7 +63,7 @@ def table():
         depths = [penetration_at(law, stiffness, exponent, load) for load in LOADS]
         cells = [f"{d * 1e6:.3f}" + ("*" if law in (JOHNSON, ESDU_78035) and d > edge_penetration(law) else "")
                  for d in depths]
-        tangent = law_stiffness(law, depths[1], stiffness, exponent, CLEARANCE)
+        tangent = law_state(law, depths[1], stiffness, exponent, CLEARANCE)[1]
         lines.append(f"| {name} | " + " | ".join(cells) + f" | {tangent:.3g} |")
     return "\n".join(lines)
 
@@ -78,7 +78,7 @@ def draw():
     for name, (law, stiffness, exponent) in coefficients().items():
         deepest = penetration_at(law, stiffness, exponent, LOADS[-1])
         depths = np.linspace(0.0, deepest, 400)
-        forces = np.array([law_force(law, d, stiffness, exponent, CLEARANCE) for d in depths])
+        forces = np.array([law_state(law, d, stiffness, exponent, CLEARANCE)[0] for d in depths])
         if law in (JOHNSON, ESDU_78035):
             inside = depths <= edge_penetration(law)
             line, = axes.plot(depths[inside] * 1e6, forces[inside] / 1e3, label=name)

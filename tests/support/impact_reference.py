@@ -13,7 +13,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
 from clearsim.physics.contact import damped_force, hertz_max_penetration, normal_force
-from clearsim.physics.cylindrical import law_force, law_max_penetration
+from clearsim.physics.cylindrical import law_max_penetration, law_state
 
 # Damped laws at low restitution leave the wall slowly (exit speed ≪ v⁻), so the
 # contact can last many Hertz times; the separation event ends the run long before.
@@ -95,7 +95,7 @@ def elastic_law_impact(damping_law, elastic_law, restitution, stiffness, exponen
     def force(penetration, penetration_rate):
         if penetration <= 0.0:
             return 0.0
-        elastic = law_force(elastic_law, penetration, stiffness, exponent, clearance)
+        elastic = law_state(elastic_law, penetration, stiffness, exponent, clearance)[0]
         return damped_force(damping_law, elastic, penetration_rate, impact_speed, restitution)
 
     depth = law_max_penetration(elastic_law, mass, impact_speed, stiffness, exponent, clearance)

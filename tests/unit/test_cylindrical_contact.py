@@ -12,8 +12,8 @@ from typer.testing import CliRunner
 from clearsim.cli import app
 from clearsim.physics import contact
 from clearsim.physics.cylindrical import (
-    ELASTIC_LAWS, ESDU_78035, JOHNSON, LIU, PEREIRA, POINT_HERTZ, effective_modulus, law_energy, law_force,
-    law_max_penetration, law_stiffness, line_contact_edge, pereira_coefficients, pereira_exponent, range_warnings,
+    ELASTIC_LAWS, ESDU_78035, JOHNSON, LIU, PEREIRA, POINT_HERTZ, effective_modulus, law_max_penetration,
+    law_state, line_contact_edge, pereira_coefficients, pereira_exponent, range_warnings,
 )
 from tests.support.impact_reference import elastic_law_impact
 from tests.validation.conftest import simulate  # noqa: F401  (the fixture: run a YAML text, read its result)
@@ -31,17 +31,17 @@ PENETRATIONS = (1e-11, 1e-9, 1e-7, 1e-6, 3e-6, 3.9e-6)
 
 def force(law, penetration):
     stiffness, exponent = COEFFICIENTS[law]
-    return law_force(law, penetration, stiffness, exponent, CLEARANCE)
+    return law_state(law, penetration, stiffness, exponent, CLEARANCE)[0]
 
 
 def stiffness(law, penetration):
     scale, exponent = COEFFICIENTS[law]
-    return law_stiffness(law, penetration, scale, exponent, CLEARANCE)
+    return law_state(law, penetration, scale, exponent, CLEARANCE)[1]
 
 
 def energy(law, penetration):
     scale, exponent = COEFFICIENTS[law]
-    return law_energy(law, penetration, scale, exponent, CLEARANCE)
+    return law_state(law, penetration, scale, exponent, CLEARANCE)[2]
 
 
 def line_penetration(load, constant):

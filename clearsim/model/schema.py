@@ -95,7 +95,8 @@ class Material(Strict):
 
 
 class ContactSpec(Strict):
-    """Normal contact law F = K δⁿ (1 + D(c_e) δ̇/δ̇⁻); every field optional at joint level."""
+    """Normal contact law F = F_el(δ) (1 + D(c_e) δ̇/δ̇⁻), F_el = K δⁿ (`elastic: point_hertz`) or a cylindrical
+    law; every field optional at joint level."""
 
     law: Literal["lankarani_nikravesh", "hertz", "hunt_crossley", "flores", "gonthier"] | None = Field(None, description="contact force law (docs/model.md §3)")
     restitution: float | None = Field(None, gt=0.0, le=1.0, description="coefficient of restitution c_e, 0 < c_e <= 1")

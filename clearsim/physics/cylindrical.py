@@ -117,7 +117,7 @@ def _normalised_load(depth, constant):
     return x
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def line_contact_state(penetration, line_stiffness, clearance, constant):
     """(F, dF/dδ, ∫₀^δ F) of δ = (F/S)[ln(4 S ΔR/F) + c] (S = π L E* in N/m, ΔR in m, F in N) at δ > 0.
 
@@ -142,7 +142,7 @@ def line_contact_state(penetration, line_stiffness, clearance, constant):
 # --- Liu et al. 2007: elastic foundation for a conformal cylindrical contact -----------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def liu_force(penetration, line_stiffness, clearance):
     """F = (S/2) δ √(δ/(2 (ΔR + δ))), S = π L E* (Liu, Zhang, Yang, Mech. Mach. Theory 42:183, 2007, an
     improved elastic foundation model fitted to finite elements; ladisk/DyS `_Fn_Liu_etal`). → S δ^1.5/(2√(2ΔR))
@@ -151,7 +151,7 @@ def liu_force(penetration, line_stiffness, clearance):
     return 0.5 * line_stiffness * penetration * math.sqrt(penetration / (2.0 * (clearance + penetration)))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def liu_stiffness(penetration, line_stiffness, clearance):
     """dF/dδ = (S/(4√2)) √δ (3 ΔR + 2 δ)/(ΔR + δ)^1.5 at δ > 0: the nonlinear stiffness coefficient
     K_n = (π E*/8) √(2 δ (3ΔR + 2δ)²/(ΔR + δ)³) of Bai & Zhao (Int. J. Non-Linear Mech. 48, 2013) times L."""
@@ -159,7 +159,7 @@ def liu_stiffness(penetration, line_stiffness, clearance):
             / (clearance + penetration) ** 1.5)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def liu_energy(penetration, line_stiffness, clearance):
     """∫₀^δ (S/(2√2)) s^1.5 (ΔR + s)^−0.5 ds. Closed form ((2δ − 3ΔR)/4) √(δ(ΔR+δ)) + (3ΔR²/4) asinh(√(δ/ΔR))
     for δ ≥ ΔR/4; below, where its terms cancel, the binomial series Σ C(−½, k) ΔR^(−½−k) δ^(k+5/2)/(k + 5/2).
@@ -184,7 +184,7 @@ def liu_energy(penetration, line_stiffness, clearance):
 # --- one law, chosen per joint --------------------------------------------------------------------------------
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def law_state(law, penetration, stiffness, exponent, clearance):
     """(F_el, dF_el/dδ, ∫₀^δ F_el) of elastic law `law` (ELASTIC_LAWS) with the joint's K, n, ΔR (module
     docstring); zeros for δ ≤ 0. The power laws: K δⁿ, n K δⁿ⁻¹, K δⁿ⁺¹/(n + 1)."""

@@ -272,6 +272,15 @@ def test_a_line_law_past_its_edge_warns_in_the_run_summary(tmp_path):
     assert "johnson elastic law reached" in " ".join(result.output.split())
 
 
+def test_pereira_outside_its_clearance_range_warns_in_the_run_summary(tmp_path):
+    """ΔR = 0.002 mm lies below the 0.005 mm of Pereira's fit."""
+    path = tmp_path / "tight.yaml"
+    path.write_text(impact_yaml("pereira", clearance=2e-6, t_end=2e-5, output_rate="1 MHz"))
+    result = CliRunner().invoke(app, ["run", str(path), "-o", str(tmp_path / "tight.h5")])
+    assert result.exit_code == 0, result.output
+    assert "pereira elastic law is fitted for clearances of 0.005–10 mm" in " ".join(result.output.split())
+
+
 # --- bad input ----------------------------------------------------------------------------------------------
 
 

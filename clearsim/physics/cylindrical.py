@@ -33,8 +33,7 @@ LIU = 4
 
 ELASTIC_LAWS = {"point_hertz": POINT_HERTZ, "johnson": JOHNSON, "esdu_78035": ESDU_78035, "pereira": PEREIRA,
                 "liu": LIU}
-POWER_LAWS = ("point_hertz", "pereira")  # F = K δⁿ: K and n are all they need
-LINE_LAWS = ("johnson", "esdu_78035")  # implicit in δ, monotone up to line_contact_edge
+POWER_LAW_CODES = (POINT_HERTZ, PEREIRA)  # F = K δⁿ: K and n are all they need
 
 # Pereira et al. 2011, internal contact (pin in a hole), ΔR in mm: the range their fit of Y(ΔR) covers
 PEREIRA_INTERNAL_A = 0.965
@@ -199,12 +198,18 @@ def law_state(law, penetration, stiffness, exponent, clearance):
             power_energy(penetration, stiffness, exponent))
 
 
+@njit(cache=True, inline="always")
+def is_power_law(law):
+    """F_el = K δⁿ (point_hertz, pereira): the closed-form Hertz estimates apply."""
+    return law in POWER_LAW_CODES
+
+
 @njit(cache=True)
 def law_max_penetration(law, effective_mass, impact_speed, stiffness, exponent, clearance):
     """δ_max of an undamped impact: ∫₀^δmax F_el = ½ m v². Closed form for the power laws
     (hertz_max_penetration); else Newton's method on the convex, rising W(δ) − ½ m v² from a start right of the
     root (doubling ΔR until W exceeds ½ m v²), which then descends monotonically to it."""
-    if law == POINT_HERTZ or law == PEREIRA:
+    if is_power_law(law):
         return hertz_max_penetration(effective_mass, stiffness, impact_speed, exponent)
     target = 0.5 * effective_mass * impact_speed * impact_speed
     if not target < math.inf:

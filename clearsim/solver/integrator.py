@@ -45,7 +45,7 @@ from clearsim.assembly.forces import (
     CONTACT, FREE, SLIDE_BACK, STICK, clearance_kinematics, contact_force_magnitudes, exact_stick,
 )
 from clearsim.physics.contact import HERTZ_CONTACT_TIME_FACTOR
-from clearsim.physics.cylindrical import PEREIRA, POINT_HERTZ, law_max_penetration
+from clearsim.physics.cylindrical import is_power_law, law_max_penetration
 from clearsim.physics.friction import static_coefficient
 from clearsim.solver.dopri import STAGES, error_norm, interpolate, step
 from clearsim.solver.samples import derive_sample
@@ -271,7 +271,7 @@ def contact_time_step(system, k, q, modes, speed):
     if not np.isfinite(mass):
         return np.inf, mass
     law = system.clearance_laws[k, 3]
-    if law != POINT_HERTZ and law != PEREIRA:
+    if not is_power_law(law):
         depth = law_max_penetration(law, mass, v, stiffness, exponent, system.clearance_params[k, CL_CLEARANCE])
         return HERTZ_CONTACT_TIME_FACTOR * depth / v / 20.0, mass
     # t_c ∝ (m/K)^(1/(n+1)) v^((1−n)/(n+1)); exact prefactor for n = 1.5, fine as a scale for any n

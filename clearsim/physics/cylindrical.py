@@ -19,6 +19,7 @@ Nonlinear Dyn. 63:681 (2011) and Skrinjar, Slavič & Boltežar, Int. J. Mech. Sc
 
 import math
 
+import numpy as np
 from numba import njit
 
 from clearsim.physics.contact import elastic_energy as power_energy
@@ -224,6 +225,16 @@ def law_max_penetration(law, effective_mass, impact_speed, stiffness, exponent, 
         if abs(step) <= 1e-14 * depth:
             break
     return depth
+
+
+@njit(cache=True)
+def max_penetrations(laws, effective_masses, impact_speeds, stiffnesses, exponents, clearances):
+    """law_max_penetration of each entry of the arrays (m)."""
+    depths = np.empty(len(laws))
+    for i in range(len(laws)):
+        depths[i] = law_max_penetration(laws[i], effective_masses[i], impact_speeds[i], stiffnesses[i],
+                                        exponents[i], clearances[i])
+    return depths
 
 
 # --- validity ---------------------------------------------------------------------------------------------------

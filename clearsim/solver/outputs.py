@@ -22,7 +22,7 @@ from clearsim.assembly.forces import STICK
 from clearsim.assembly.dynamics import WORK_APPLIED, WORK_CONTACT, WORK_DAMPING, WORK_DRIVER, WORK_FRICTION
 from clearsim.assembly.system import SensorSpec, System
 from clearsim.model import schema
-from clearsim.physics.cylindrical import POWER_LAW_CODES, law_max_penetration
+from clearsim.physics.cylindrical import POWER_LAW_CODES, max_penetrations
 from clearsim.units import UnitError, to_si
 from clearsim.solver.samples import C_ECC_X, C_ECC_Y, C_FRICTION, C_NORMAL, C_PENETRATION, C_RATE, C_SLIDING
 
@@ -122,9 +122,10 @@ def hertz_durations(system: System, joints: np.ndarray, impact_speeds: np.ndarra
     exponent = params[:, CL_EXPONENT]
     depth = (5.0 * effective_masses * speed**2 / (4.0 * params[:, CL_STIFFNESS])) ** (1.0 / (exponent + 1.0))
     laws = system.arrays.clearance_laws[joints, 3]
-    for i in np.flatnonzero(np.isin(laws, POWER_LAW_CODES, invert=True)):
-        depth[i] = law_max_penetration(laws[i], effective_masses[i], speed[i], params[i, CL_STIFFNESS],
-                                       exponent[i], params[i, CL_CLEARANCE])
+    other = np.isin(laws, POWER_LAW_CODES, invert=True)
+    if other.any():
+        depth[other] = max_penetrations(laws[other], np.asarray(effective_masses, float)[other], speed[other],
+                                        params[other, CL_STIFFNESS], exponent[other], params[other, CL_CLEARANCE])
     return HERTZ_DURATION * depth / speed
 
 

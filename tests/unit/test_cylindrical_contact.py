@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 
 from clearsim.cli import app
 from clearsim.physics import contact
+from clearsim.solver.outputs import IMPACT
 from clearsim.physics.cylindrical import (
     ELASTIC_LAWS, ESDU_78035, JOHNSON, LIU, PEREIRA, POINT_HERTZ, effective_modulus, law_max_penetration,
     law_state, line_contact_edge, pereira_coefficients, pereira_exponent, range_warnings,
@@ -216,6 +217,7 @@ def test_single_impact_matches_the_one_dof_reference(simulate, elastic):
     assert restitution == pytest.approx(reference.restitution, rel=1e-4)
     assert duration == pytest.approx(reference.contact_time, rel=1e-4)
     assert np.max(result["joints/O/normal_force"]) == pytest.approx(reference.peak_force, rel=1e-3)
+    assert result["joints/O/episodes/kind"][0] == IMPACT  # its duration against the law's own contact time
 
 
 PENDULUM = """

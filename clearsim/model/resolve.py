@@ -243,10 +243,11 @@ def _elastic_coefficients(contact: dict, origin: dict, bearing: float, journal: 
     if "length" not in contact:
         raise _error_at(origin, "elastic", f"the elastic law '{elastic}' needs the pin's axial length",
                         "add `length: 50 mm` to the joint's contact or to defaults.contact", "contact")
+    # a point-law K or n written in a layer below the one that chose this law belongs to the point law there
     written = {"stiffness": not _is_auto(contact["stiffness"]),
                "exponent": not math.isclose(contact["exponent"], AUTO_STIFFNESS_EXPONENT)}
     for name in written:
-        if origin.get(name) is not None and written[name]:
+        if written[name] and _layer(origin.get(name)) >= _layer(origin.get("elastic")):
             raise _error_at(origin, name, f"`{name}` belongs to the point_hertz law; the '{elastic}' law takes its "
                             "stiffness from the length, the clearance and the material",
                             f"remove `{name}` (or write `{name}: {'auto' if name == 'stiffness' else '1.5'}`), or "
@@ -272,6 +273,11 @@ def _stiffness(contact: dict, origin: dict, bearing: float, journal: float, mate
     if stiffness <= 0.0:
         raise _error_at(origin, "stiffness", f"the contact stiffness must be positive, got {value!r}", None, "contact")
     return stiffness
+
+
+def _layer(where) -> int:
+    """0 built in, 1 `defaults:`, 2 the joint (an origin of _merged_contact)."""
+    return 0 if where is None else 1 if where[0] else 2
 
 
 def _is_auto(stiffness) -> bool:

@@ -283,6 +283,17 @@ def test_pereira_outside_its_clearance_range_warns_in_the_run_summary(tmp_path):
     assert "pereira elastic law is fitted for clearances of 0.005–10 mm" in " ".join(result.output.split())
 
 
+def test_a_joint_choosing_a_cylindrical_law_leaves_the_defaults_point_stiffness_to_the_other_joints(tmp_path):
+    """defaults: a point law with its K; joint O: `elastic: liu` — the joint's choice starts that law afresh."""
+    text = impact_yaml("point_hertz").replace("elastic: point_hertz, length: 50 mm, ",
+                                              "stiffness: 1.2e12 N/m^1.5, exponent: 1.5, ")
+    text = text.replace("initial_velocity:", "contact: {elastic: liu, length: 50 mm}, initial_velocity:")
+    path = tmp_path / "mixed.yaml"
+    path.write_text(text)
+    result = CliRunner().invoke(app, ["validate", str(path)])
+    assert result.exit_code == 0, result.output
+
+
 # --- bad input ----------------------------------------------------------------------------------------------
 
 

@@ -255,7 +255,11 @@ def _elastic_coefficients(contact: dict, origin: dict, bearing: float, journal: 
     modulus = effective_modulus(material.youngs_modulus, material.poisson_ratio, material.youngs_modulus,
                                 material.poisson_ratio)
     if elastic == "pereira":
-        return pereira_coefficients(clearance, contact["length"], modulus)
+        try:
+            return pereira_coefficients(clearance, contact["length"], modulus)
+        except ValueError as exc:
+            raise _error_at(origin, "elastic", str(exc), "choose another elastic law for so small a clearance",
+                            "contact") from None
     return math.pi * contact["length"] * modulus, 1.0  # S = π L E*; the exponent is not used
 
 

@@ -41,20 +41,25 @@ PEREIRA_INTERNAL_A = 0.965
 PEREIRA_INTERNAL_B = 0.0965
 PEREIRA_CLEARANCE_RANGE_MM = (0.005, 10.0)
 _PEREIRA_Y_BREAK_MM = 0.34954  # the two branches of Y meet here (1.15627)
+PEREIRA_UNDEFINED_BELOW_MM = 0.001  # ln(1000 ΔR) ≤ 0
 
 _NEWTON_ITERATIONS = 100
 _RELATIVE_TOLERANCE = 4e-16
 
 
 def effective_modulus(youngs_bearing, poisson_bearing, youngs_journal, poisson_journal):
-    """E* = 1/((1 − ν_B²)/E_B + (1 − ν_J²)/E_J) in Pa (Johnson, Contact Mechanics 1985, eq. 4.22)."""
+    """E* = 1/((1 − ν_B²)/E_B + (1 − ν_J²)/E_J) in Pa (Johnson, Contact Mechanics 1985)."""
     return 1.0 / ((1.0 - poisson_bearing**2) / youngs_bearing + (1.0 - poisson_journal**2) / youngs_journal)
 
 
 def pereira_exponent(clearance):
     """n = Y ΔR^−0.005 (ΔR in mm) with Y = 1.51 [ln(1000 ΔR)]^−0.151 for 0.005 ≤ ΔR ≤ 0.34954 mm and
-    Y = 0.0151 ΔR + 1.151 for 0.34954 < ΔR ≤ 10 mm (Pereira, Ramalho & Ambrósio 2011, internal contact)."""
+    Y = 0.0151 ΔR + 1.151 for 0.34954 < ΔR ≤ 10 mm (Pereira, Ramalho & Ambrósio 2011, internal contact).
+    ValueError for ΔR ≤ 0.001 mm, where ln(1000 ΔR) ≤ 0 leaves Y undefined."""
     clearance_mm = clearance * 1e3
+    if clearance_mm <= PEREIRA_UNDEFINED_BELOW_MM:
+        raise ValueError(f"Pereira's exponent is undefined for clearances of {PEREIRA_UNDEFINED_BELOW_MM:g} mm and "
+                         f"below (ΔR = {clearance_mm:.3g} mm)")
     if clearance_mm <= _PEREIRA_Y_BREAK_MM:
         y = 1.51 * math.log(1e3 * clearance_mm) ** -0.151
     else:

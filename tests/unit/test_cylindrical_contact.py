@@ -297,16 +297,18 @@ def test_a_joint_choosing_a_cylindrical_law_leaves_the_defaults_point_stiffness_
 # --- bad input ----------------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize(("edit", "fragments"), [
-    (("length: 50 mm", "length: -50 mm"), ("length",)),
-    (("length: 50 mm, ", ""), ("elastic", "needs the pin's axial length")),
-    (("elastic: johnson", "elastic: johnson, stiffness: 1e12 N/m^1.5"), ("stiffness", "point_hertz")),
+@pytest.mark.parametrize(("elastic", "clearance", "edit", "fragments"), [
+    ("johnson", WIDE_CLEARANCE, ("length: 50 mm", "length: -50 mm"), ("length",)),
+    ("johnson", WIDE_CLEARANCE, ("length: 50 mm, ", ""), ("elastic", "needs the pin's axial length")),
+    ("johnson", WIDE_CLEARANCE, ("elastic: johnson", "elastic: johnson, stiffness: 1e12 N/m^1.5"),
+     ("stiffness", "point_hertz")),
+    ("pereira", 5e-7, ("", ""), ("elastic", "undefined for clearances of 0.001 mm and below")),
 ])
-def test_bad_input_is_located_exit_2(tmp_path, edit, fragments):
+def test_bad_input_is_located_exit_2(tmp_path, elastic, clearance, edit, fragments):
     path = tmp_path / "bad.yaml"
-    text = impact_yaml("johnson")
+    text = impact_yaml(elastic, clearance=clearance)
     assert edit[0] in text
-    path.write_text(text.replace(*edit))
+    path.write_text(text.replace(*edit) if edit[0] else text)
     result = CliRunner().invoke(app, ["run", str(path), "-o", str(tmp_path / "bad.h5")])
     assert result.exit_code == 2, result.output
     assert "Traceback" not in result.output

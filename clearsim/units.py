@@ -94,6 +94,7 @@ DIMENSIONS = {
     "pressure": Dimension("pressure (modulus)", "Pa", _dims(mass=1, length=-1, time=-2), "207 GPa"),
     "spring_stiffness": Dimension("spring stiffness", "N/m", _dims(mass=1, time=-2), "1e5 N/m"),
     "damping": Dimension("damping coefficient", "N*s/m", _dims(mass=1, time=-1), "50 N*s/m"),
+    "viscosity": Dimension("dynamic viscosity", "Pa*s", _dims(mass=1, length=-1, time=-1), "0.1 Pa*s"),
     "dimensionless": Dimension("dimensionless number", "1", (), "0.2"),
 }
 
@@ -110,6 +111,7 @@ DERIVED_UNITS = {  # the other kinds, built from the base ones unless the block 
     "pressure": "{force}/{length}^2",
     "spring_stiffness": "{force}/{length}",
     "damping": "{force}*{time}/{length}",
+    "viscosity": "{force}*{time}/{length}^2",
 }
 CONTACT_STIFFNESS_UNIT = "{force}/{length}^{exponent:g}"  # K of F = K δⁿ
 
@@ -409,4 +411,5 @@ Area = _quantity_type("area")
 Pressure = _quantity_type("pressure")
 SpringStiffness = _quantity_type("spring_stiffness")
 Damping = _quantity_type("damping")
+Viscosity = _quantity_type("viscosity")
 Number = _quantity_type("dimensionless")

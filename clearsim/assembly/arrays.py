@@ -38,10 +38,14 @@ CL_MU_S = 11
 CL_MU_D = 12
 CL_V_LOW = 13
 CL_V_HIGH = 14
-CLEARANCE_COLUMNS = 15
+CL_VISCOSITY = 15  # oil film (physics/lubrication.py): μ in Pa·s, 0 for a dry joint
+CL_FILM_LENGTH = 16  # m, pin length wetted by the film
+CL_DRY_GAP = 17  # m, film thickness at which the dry contact starts (δ = |e| − c + this); 0 for a dry joint
+CLEARANCE_COLUMNS = 18
 # columns of clearance_laws: damping law (contact.CONTACT_LAWS), friction law, stick treatment, elastic law
-# (cylindrical.ELASTIC_LAWS)
-CLEARANCE_LAW_COLUMNS = 4
+# (cylindrical.ELASTIC_LAWS), film model (lubrication.BEARING_MODELS)
+CLEARANCE_LAW_COLUMNS = 5
+LAW_FILM_MODEL = 4
 
 # columns of offset_params
 OFF_POINT_I = 0  # 0, 1

@@ -12,14 +12,14 @@ from pathlib import Path
 import numpy as np
 
 from clearsim.assembly.arrays import (
-    CLEARANCE_COLUMNS, CLEARANCE_LAW_COLUMNS, CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_EXPONENT,
-    CL_JOURNAL_POINT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_RESTITUTION, CL_STIFFNESS,
-    CL_V_HIGH, CL_V_LOW, LOAD_COLUMNS, SPRING_COLUMNS, SystemArrays,
+    CLEARANCE_COLUMNS, CLEARANCE_LAW_COLUMNS, CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_DRY_GAP,
+    CL_EXPONENT, CL_FILM_LENGTH, CL_JOURNAL_POINT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S,
+    CL_RESTITUTION, CL_STIFFNESS, CL_V_HIGH, CL_V_LOW, CL_VISCOSITY, LOAD_COLUMNS, SPRING_COLUMNS, SystemArrays,
 )
 from clearsim.errors import Problem
 from clearsim.model import schema
 from clearsim.model.resolve import ClearanceParameters, resolve_clearance
-from clearsim.physics import contact, cylindrical, friction, motion
+from clearsim.physics import contact, cylindrical, friction, lubrication, motion
 from clearsim.physics.tables import read_table_column
 from clearsim.units import UnitError, to_si
 
@@ -218,6 +218,9 @@ def clearance_row(si, sj, parameters: ClearanceParameters) -> np.ndarray:
     row[CL_MU_D] = parameters.mu_d
     row[CL_V_LOW] = parameters.v_low
     row[CL_V_HIGH] = parameters.v_high
+    row[CL_VISCOSITY] = parameters.viscosity
+    row[CL_FILM_LENGTH] = parameters.film_length
+    row[CL_DRY_GAP] = parameters.dry_below
     return row
 
 
@@ -248,7 +251,8 @@ def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: l
         law_breaks=breaks, law_coefficients=coefficients, law_first=first, law_count=count,
         clearance_bodies=_int_array([c[:2] for c in clearances], 2),
         clearance_laws=_int_array([(contact.CONTACT_LAWS[c[4].law], friction.FRICTION_LAWS[c[4].friction_law],
-                                    friction.STICK_TREATMENTS[c[4].stick], cylindrical.ELASTIC_LAWS[c[4].elastic])
+                                    friction.STICK_TREATMENTS[c[4].stick], cylindrical.ELASTIC_LAWS[c[4].elastic],
+                                    lubrication.BEARING_MODELS[c[4].film_model])
                                    for c in clearances], CLEARANCE_LAW_COLUMNS),
         clearance_params=_float_array([clearance_row(c[2], c[3], c[4]) for c in clearances], CLEARANCE_COLUMNS),
         load_bodies=_int_array([ld[0] for ld in loads]),

@@ -6,6 +6,9 @@ penetration rate δ̇ = ė·n, tangent t = (−n_y, n_x) and sliding velocity
 v_t = ė·t + ω_J R_J − ω_B R_B (material points of journal and bearing at the contact).
 Forces act on the journal at P_J + R_J n:  −F_n n − μ(v_t) F_n t, and the opposite on the bearing
 at P_B + R_B n. Dissipated powers (F_n − F_el(δ)) δ̇ and μ(v_t) F_n v_t are returned for the energy balance.
+A lubricated joint (docs/model-contact.md) measures δ from the film threshold, δ = |e| − c + h_dry, and while
+free of dry contact carries its oil film's force and torque instead; the power the film takes out is booked
+with the contact's.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ from numba import njit
 from clearsim.assembly.arrays import (
     CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_POINT,
     CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_RESTITUTION, CL_STIFFNESS,
-    CL_V_HIGH, CL_V_LOW,
+    CL_V_HIGH, CL_V_LOW, CL_DRY_GAP, CL_FILM_LENGTH, CL_VISCOSITY, LAW_FILM_MODEL,
 )
 from clearsim.assembly.kinematics import (
     GROUND, add_point_force, body_frame, body_pose, body_rates, frame_point, frame_rotate, frame_velocity,
@@ -26,6 +29,7 @@ from clearsim.assembly.constraints import prescribed
 from clearsim.physics.contact import damped_force
 from clearsim.physics.cylindrical import law_state
 from clearsim.physics.friction import STICK_EXACT, friction_coefficient, sliding_coefficient
+from clearsim.physics.lubrication import film_force, film_torque
 
 # modes of a clearance joint, constant within a step. CONTACT is any contact of a smooth friction
 # law, and sliding along +t under an exact-stick law; STICK and SLIDE_BACK (sliding along −t)
@@ -67,7 +71,8 @@ def clearance_kinematics(system, k, q, qd):
         nx, ny = ex / eccentricity, ey / eccentricity
     sliding = (-ny * dex + nx * dey + body_rates(qd, journal)[2] * p[CL_JOURNAL_RADIUS]
                - body_rates(qd, bearing)[2] * p[CL_BEARING_RADIUS])
-    return ex, ey, dex, dey, eccentricity - p[CL_CLEARANCE], nx * dex + ny * dey, nx, ny, sliding
+    penetration = eccentricity - p[CL_CLEARANCE] + p[CL_DRY_GAP]
+    return ex, ey, dex, dey, penetration, nx * dex + ny * dey, nx, ny, sliding
 
 
 @njit(cache=True)
@@ -128,6 +133,9 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized):
     friction_loss = 0.0
     for k in range(system.clearance_bodies.shape[0]):
         ex, ey, dex, dey, penetration, rate, nx, ny, sliding = clearance_kinematics(system, k, q, qd)
+        if modes[k] == FREE and system.clearance_params[k, CL_VISCOSITY] > 0.0:
+            contact_loss += add_film_forces(system, k, q, qd, generalized)
+            continue
         fn, ft, elastic = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], impact_speeds[k])
         contact_loss += (fn - elastic) * rate  # also while the damping term clips F_n to 0 with δ > 0
         if fn == 0.0:
@@ -144,6 +152,48 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized):
                          by + p[CL_BEARING_RADIUS] * ny, -fx, -fy)
         friction_loss -= ft * sliding
     return contact_loss, friction_loss
+
+
+MAX_FILM_ECCENTRICITY = 1.0 - 1e-9  # ε of a trial stage beyond the wall (rejected by the step control) is capped
+
+
+@njit(cache=True)
+def film_state(system, k, q, qd):
+    """(ε, ε̇, wedge speed ω_J + ω_B − 2φ̇, ω_J − ω_B) of lubricated joint k (docs/model-contact.md)."""
+    p = system.clearance_params[k]
+    ex, ey, dex, dey, _, rate, nx, ny, _ = clearance_kinematics(system, k, q, qd)
+    eccentricity = np.sqrt(ex * ex + ey * ey)
+    orbit_rate = (-ny * dex + nx * dey) / eccentricity if eccentricity > 1e-300 else 0.0
+    wj = body_rates(qd, system.clearance_bodies[k, 1])[2]
+    wb = body_rates(qd, system.clearance_bodies[k, 0])[2]
+    eps = min(eccentricity / p[CL_CLEARANCE], MAX_FILM_ECCENTRICITY)
+    return eps, rate / p[CL_CLEARANCE], wj + wb - 2.0 * orbit_rate, wj - wb
+
+
+@njit(cache=True)
+def add_film_forces(system, k, q, qd, generalized):
+    """Add the oil film's force and torque on the journal of joint k (the opposite on the bearing, at the same
+    point P_J); return the power the film takes out, −F·(v_J − v_B)(P_J) − T (ω_J − ω_B)."""
+    p = system.clearance_params[k]
+    eps, eps_rate, wedge, spin = film_state(system, k, q, qd)
+    fn, ft = film_force(system.clearance_laws[k, LAW_FILM_MODEL], p[CL_VISCOSITY], p[CL_JOURNAL_RADIUS],
+                        p[CL_FILM_LENGTH], p[CL_CLEARANCE], eps, eps_rate, wedge)
+    torque = film_torque(p[CL_VISCOSITY], p[CL_JOURNAL_RADIUS], p[CL_FILM_LENGTH], p[CL_CLEARANCE], eps, spin)
+    ex, ey, dex, dey, _, _, nx, ny, _ = clearance_kinematics(system, k, q, qd)
+    fx = fn * nx - ft * ny
+    fy = fn * ny + ft * nx
+    bearing = system.clearance_bodies[k, 0]
+    journal = system.clearance_bodies[k, 1]
+    bx, by = point_position(q, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+    add_global_force(generalized, q, journal, bx + ex, by + ey, fx, fy)
+    add_global_force(generalized, q, bearing, bx + ex, by + ey, -fx, -fy)
+    if journal != GROUND:
+        generalized[3 * journal + 2] += torque
+    if bearing != GROUND:
+        generalized[3 * bearing + 2] -= torque
+    wb = body_rates(qd, bearing)[2]
+    relative_x, relative_y = dex + wb * ey, dey - wb * ex  # journal centre relative to the bearing point under it
+    return -(fx * relative_x + fy * relative_y) - torque * spin
 
 
 @njit(cache=True)

@@ -180,6 +180,10 @@ def _check_location(names: _Names, joint, path: tuple) -> list[Problem]:
 
 
 def _check_clearance(joint: schema.RevoluteJoint, path: tuple, defaults: schema.Defaults) -> list[Problem]:
+    if joint.lubrication is not None and not is_clearance_joint(joint):
+        return [Problem(path + ("lubrication",), f"joint '{joint.name}' is lubricated but has no clearance",
+                        "an oil film needs a gap: give the joint `clearance: 0.05 mm` (or `journal_radius:`), "
+                        "or remove `lubrication:`")]
     try:
         resolve_clearance(joint, defaults)
     except ResolveError as exc:

@@ -15,7 +15,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from clearsim.model.schema import DEFAULT_CONTACT, FRICTION_OPTIONS, FRICTION_PARAMETERS, ContactSpec, Defaults, FrictionSpec
+from clearsim.model.schema import (
+    DEFAULT_CONTACT, DEFAULT_LUBRICATION, FRICTION_OPTIONS, FRICTION_PARAMETERS, ContactSpec, Defaults, FrictionSpec,
+    LubricationSpec,
+)
 from clearsim.units import UnitError, contact_stiffness_to_si
 
 BUILTIN_FRICTION = FrictionSpec(law="none")
@@ -53,6 +56,10 @@ class ClearanceParameters:
     initial_velocity: tuple[float, float] = (0.0, 0.0)  # m/s, its rate at t = 0
     elastic: str = "point_hertz"  # the elastic law (clearsim.physics.cylindrical); stiffness, exponent are its K, n
     length: float = 0.0  # m, the pin's axial length L (0: not given)
+    viscosity: float = 0.0  # Pa·s, oil film; 0: a dry joint
+    film_length: float = 0.0  # m, pin length wetted by the film
+    film_model: str = "short_bearing"
+    dry_below: float = 0.0  # m, film thickness below which the dry laws act (0 for a dry joint)
 
 
 def is_clearance_joint(joint) -> bool:
@@ -81,6 +88,7 @@ def resolve_clearance(joint, defaults: Defaults) -> ClearanceParameters | None:
         friction_law=friction["law"], **_friction_numbers(friction),
         initial_eccentricity=_initial_eccentricity(joint, clearance),
         initial_velocity=tuple(map(float, getattr(joint, "initial_velocity", None) or (0.0, 0.0))),
+        **_film_numbers(*_merged_lubrication(joint, defaults), clearance, contact.get("length")),
     )
 
 
@@ -148,6 +156,20 @@ def _merged_contact(joint, defaults: Defaults) -> tuple[dict, dict]:
     values, origin = {}, {}
     for spec, where in _layers(joint, defaults, "contact", DEFAULT_CONTACT):
         for name in ContactSpec.model_fields:
+            if getattr(spec, name) is not None:
+                values[name], origin[name] = getattr(spec, name), where
+    return values, origin
+
+
+def _merged_lubrication(joint, defaults: Defaults) -> tuple[dict, dict]:
+    """Lubrication fields merged field by field over the built-in film defaults; {} when no layer has a film."""
+    layers = [(spec, where) for spec, where in _layers(joint, defaults, "lubrication", DEFAULT_LUBRICATION)
+              if spec is not None]
+    if len(layers) == 1:
+        return {}, {}
+    values, origin = {}, {}
+    for spec, where in layers:
+        for name in LubricationSpec.model_fields:
             if getattr(spec, name) is not None:
                 values[name], origin[name] = getattr(spec, name), where
     return values, origin
@@ -226,6 +248,26 @@ def _friction_numbers(friction: dict) -> dict:
     stick = friction.get("stick", FRICTION_OPTIONS.get(law, {}).get("stick", "smooth"))
     return {"mu_s": friction.get("mu_s", 0.0), "mu_d": friction.get("mu_d", 0.0), "v_low": low, "v_high": high,
             "stick": stick}
+
+
+# --- lubrication ----------------------------------------------------------------------------------
+
+
+def _film_numbers(lubrication: dict, origin: dict, clearance: float, pin_length: float | None) -> dict:
+    """The film's numbers; checks that a lubricated joint has a length (its own, else the pin's `contact.length`)
+    and a dry threshold inside c."""
+    if not lubrication.get("viscosity"):
+        return {}
+    length = lubrication.get("length", pin_length)
+    if length is None:
+        raise _error_at(origin, "viscosity", "a lubricated joint needs the pin's length L (the film's width)",
+                        "add `length: 50 mm` to the joint's contact (the pin) or to its lubrication", "lubrication")
+    if lubrication["dry_below"] >= clearance:
+        raise _error_at(origin, "dry_below", f"the film threshold dry_below = {_mm(lubrication['dry_below'])} must "
+                        f"be smaller than the clearance {_mm(clearance)}", "the film acts while c − |e| > dry_below: "
+                        "a fraction of c, e.g. three times the composite roughness", "lubrication")
+    return {"viscosity": lubrication["viscosity"], "film_length": length,
+            "film_model": lubrication["model"], "dry_below": lubrication["dry_below"]}
 
 
 # --- contact stiffness ----------------------------------------------------------------------------

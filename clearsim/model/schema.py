@@ -36,6 +36,7 @@ from clearsim.units import (
     Time,
     Torque,
     UnitError,
+    Viscosity,
     UnitSystem,
     bare_number,
     bare_number_message,
@@ -144,11 +145,30 @@ FRICTION_PARAMETERS = {
 FRICTION_OPTIONS = {"coulomb": {"stick": "exact"}, "stiction_step": {"stick": "exact"}}  # optional keys, defaults
 
 
+class LubricationSpec(Strict):
+    """Oil film of a clearance joint (docs/model-contact.md, lubricated joints); fields merge over defaults."""
+
+    viscosity: Viscosity | None = Field(None, ge=0.0, description="dynamic viscosity μ of the oil; 0: a dry joint")
+    length: Length | None = Field(None, gt=0.0, description="axial length L wetted by the film; default: the pin's "
+                                  "`contact.length`")
+    model: Literal["short_bearing", "long_bearing"] | None = Field(
+        None, description="film model: short_bearing (Ocvirk, L/D < 1/2, default) or long_bearing (Sommerfeld, L/D > 2)")
+    cavitation: Literal["half_sommerfeld"] | None = Field(
+        None, description="cavitation condition: half_sommerfeld (Gümbel: negative pressures set to 0)")
+    dry_below: Length | None = Field(
+        None, gt=0.0, description="film thickness h = c - |e| below which the dry contact and friction laws act "
+        "instead of the film (default 1.5 µm: three times a composite roughness of 0.5 µm)")
+
+
+DEFAULT_LUBRICATION = LubricationSpec(model="short_bearing", cavitation="half_sommerfeld", dry_below=1.5e-6)
+
+
 class Defaults(Strict):
     bearing_radius: Length | None = Field(None, gt=0.0, description="bearing radius R_B of clearance joints")
     material: Material = Material()
     contact: ContactSpec = DEFAULT_CONTACT
     friction: FrictionSpec = FrictionSpec(law="none")
+    lubrication: LubricationSpec | None = Field(None, description="oil film of every clearance joint; absent: dry")
 
 
 # --- bodies ---------------------------------------------------------------------------------------
@@ -204,6 +224,7 @@ class RevoluteJoint(Strict):
     material: Material | None = None
     contact: ContactSpec | None = None
     friction: FrictionSpec | None = None
+    lubrication: LubricationSpec | None = Field(None, description="oil film (a clearance joint only); merges over defaults.lubrication")
     initial_eccentricity: Point | None = Field(None, description="journal centre - bearing centre at t = 0")
     initial_velocity: tuple[Speed, Speed] | None = Field(
         None, description="velocity of the journal centre relative to the bearing centre at t = 0 (default 0)")

@@ -143,3 +143,32 @@ def test_bad_lubrication_input_exits_2_with_one_located_message(tmp_path, case):
     for fragment in fragments:
         assert fragment in result.output, result.output
     assert not output.exists()
+
+
+def test_the_dry_modes_ignore_the_oil_and_the_film_mode_carries_it_alone():
+    """At one state near the wall: in the dry contact mode the forces do not depend on the viscosity; in the
+    film mode they are the film's alone (linear in μ, no dry force although the film is thinner than c)."""
+    from clearsim.assembly.arrays import for_kernels
+    from clearsim.assembly.dynamics import generalized_forces
+    from clearsim.assembly.forces import CONTACT, FREE
+    from clearsim.model.loader import load_mechanism_text
+    from clearsim.runner import prepare
+
+    text = journal(0.0, 1.0, spin=500.0, speed=0.3).replace(
+        "initial_velocity:", f"initial_eccentricity: [0 m, {-(CLEARANCE - DRY_BELOW + 1e-7)} m], initial_velocity:")
+
+    def forces(viscosity, mode):
+        system = prepare(load_mechanism_text(text, overrides=(f"joints.O.lubrication.viscosity={viscosity} Pa*s",)))
+        modes = np.array([mode], dtype=np.int64)
+        generalized, *powers = generalized_forces(for_kernels(system.arrays), 0.0, system.q0, system.qd0, modes,
+                                                  np.array([0.3]))
+        return generalized, powers[2]
+
+    dry, dry_loss = forces(0.05, CONTACT)
+    assert np.linalg.norm(dry[:2]) > 0.0  # precondition: δ = 0.1 µm past the threshold, a dry force acts
+    assert np.array_equal(forces(0.5, CONTACT)[0], dry)
+    thin, thin_loss = forces(0.05, FREE)
+    thick, thick_loss = forces(0.5, FREE)
+    assert np.linalg.norm(thin[:2]) > 0.0 and thin_loss > 0.0
+    np.testing.assert_allclose(thick, 10.0 * thin, rtol=1e-12)
+    assert thick_loss == pytest.approx(10.0 * thin_loss, rel=1e-12)

@@ -3,10 +3,10 @@
 Frame of the eccentricity: n = e/|e| (bearing centre → journal centre), t = n turned by +90°. The angle θ is
 measured from n, counter-clockwise, so the film thickness is h(θ) = c (1 − ε cos θ), ε = |e|/c, thinnest at θ = 0.
 The surfaces move at ω_J and ω_B, the line of centres turns at φ̇ = t·ė/|e| and ε̇ = n·ė/c; in the frame of the
-line of centres Reynolds' equation (Pinkus & Sternlicht, *Theory of Hydrodynamic Lubrication*, 1961, ch. 14;
-Frêne et al., *Hydrodynamic Lubrication*, 1997, ch. 6) reads
+line of centres Reynolds' equation (Pinkus & Sternlicht, *Theory of Hydrodynamic Lubrication*, 1961;
+Frêne et al., *Hydrodynamic Lubrication*, 1997) reads, with x = Rθ
 
-    ∂/∂x (h³ ∂p/∂x) + ∂/∂z (h³ ∂p/∂z) = 6 μ (ω_J + ω_B − 2 φ̇) R ∂h/∂θ / R + 12 μ ∂h/∂t,
+    ∂/∂x (h³ ∂p/∂x) + ∂/∂z (h³ ∂p/∂z) = 6 μ (ω_J + ω_B − 2 φ̇) ∂h/∂θ + 12 μ ∂h/∂t,
 
 the wedge term driven by w = ω_J + ω_B − 2φ̇ and the squeeze term by ε̇. Short bearing (Ocvirk, L/D → 0): the
 circumferential flow term is dropped. Long bearing (Sommerfeld, L/D → ∞): the axial one is dropped, with p = 0 at
@@ -25,7 +25,6 @@ from numba import njit
 SHORT_BEARING = 0
 LONG_BEARING = 1
 BEARING_MODELS = {"short_bearing": SHORT_BEARING, "long_bearing": LONG_BEARING}
-CAVITATION_MODELS = {"half_sommerfeld": 0}
 
 SMALL_ECCENTRICITY = 1e-4  # below it the film integrals use their Taylor series in ε (cancellation above 1e-8)
 LONG_BEARING_SAMPLES = 48  # sign samples per turn when the long bearing's zero-pressure angles are searched
@@ -79,7 +78,7 @@ def film_integrals(lo, hi, eps):
 @njit(cache=True)
 def short_bearing_force(viscosity, radius, length, clearance, eps, eps_rate, wedge_speed):
     """(F_n, F_t) of the Ocvirk short bearing, half-Sommerfeld: P(θ) = ∫p dz = μL³(2ε̇ cos θ − ε w sin θ)/(2c²D³)
-    (Pinkus & Sternlicht 1961 ch. 14; Frêne et al. 1997 §6.3), F = −R ∫ P (cos θ, sin θ) dθ where P > 0."""
+    (Ocvirk 1952; Pinkus & Sternlicht 1961; Frêne et al. 1997), F = −R ∫ P (cos θ, sin θ) dθ where P > 0."""
     squeeze = 2.0 * eps_rate
     wedge = -eps * wedge_speed
     if squeeze == 0.0 and wedge == 0.0:
@@ -132,8 +131,9 @@ def _pressure_derivative_moments(lo, hi, eps, eps_rate, wedge_speed):
 @njit(cache=True)
 def long_bearing_force(viscosity, radius, length, clearance, eps, eps_rate, wedge_speed):
     """(F_n, F_t) of the Sommerfeld long bearing, half-Sommerfeld: F = −RL ∫ p (cos θ, sin θ) dθ over the arcs
-    where p > 0, by parts with p = 0 at their ends: ∫p cos = −∫p' sin, ∫p sin = ∫p' cos. The arcs' ends are
-    the sign changes of p between LONG_BEARING_SAMPLES samples per turn, refined by bisection."""
+    where p > 0, by parts with p = 0 at their ends: ∫p cos = −∫p' sin, ∫p sin = ∫p' cos (Sommerfeld 1904;
+    Pinkus & Sternlicht 1961). The arcs' ends are the sign changes of p between LONG_BEARING_SAMPLES samples per
+    turn, refined by bisection."""
     step = 2.0 * math.pi / LONG_BEARING_SAMPLES
     cos_part = 0.0
     sin_part = 0.0
@@ -165,7 +165,7 @@ def film_force(model, viscosity, radius, length, clearance, eps, eps_rate, wedge
 
 @njit(cache=True)
 def film_torque(viscosity, radius, length, clearance, eps, relative_speed):
-    """Viscous torque on the journal, −2π μ R³ L (ω_J − ω_B)/(c √(1 − ε²)): Couette shear over the whole film
-    (Petroff 1883 at ε = 0; Pinkus & Sternlicht 1961 eq. 3-52 without the pressure-flow term)."""
+    """Viscous torque on the journal, −2π μ R³ L (ω_J − ω_B)/(c √(1 − ε²)): the Couette shear μ R (ω_J − ω_B)/h
+    over the whole film, ∫dθ/D = 2π/√(1 − ε²) (Petroff 1883 at ε = 0), without the pressure-flow term."""
     return -2.0 * math.pi * viscosity * radius ** 3 * length * relative_speed / (
         clearance * math.sqrt(1.0 - eps * eps))

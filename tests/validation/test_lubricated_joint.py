@@ -145,6 +145,19 @@ def test_bad_lubrication_input_exits_2_with_one_located_message(tmp_path, case):
     assert not output.exists()
 
 
+def test_the_film_takes_the_pins_contact_length_unless_its_own_is_given():
+    from clearsim.model.loader import load_mechanism_text
+    from clearsim.model.resolve import resolve_clearance
+
+    def film_length(text):
+        mechanism = load_mechanism_text(text).mechanism
+        return resolve_clearance(mechanism.joints[0], mechanism.defaults).film_length
+
+    pin = journal(10.0, 1.0).replace("stiffness: 1e12 N/m^1.5", "stiffness: 1e12 N/m^1.5, length: 40 mm")
+    assert film_length(pin) == pytest.approx(0.010)  # the lubrication block's own
+    assert film_length(pin.replace(", length: 10 mm", "")) == pytest.approx(0.040)  # the contact's
+
+
 def test_the_dry_modes_ignore_the_oil_and_the_film_mode_carries_it_alone():
     """At one state near the wall: in the dry contact mode the forces do not depend on the viscosity; in the
     film mode they are the film's alone (linear in μ, no dry force although the film is thinner than c)."""

@@ -17,7 +17,9 @@ from typing import Callable
 
 import numpy as np
 
-from clearsim.assembly.arrays import CL_CLEARANCE, CL_STIFFNESS
+from clearsim.assembly.arrays import (
+    CL_CLEARANCE, CL_DRY_GAP, CL_FILM_LENGTH, CL_JOURNAL_RADIUS, CL_STIFFNESS, CL_VISCOSITY, LAW_FILM_MODEL,
+)
 from clearsim.assembly.build import BuildError
 from clearsim.assembly.system import System, assemble
 from clearsim.errors import ClearsimError, InputError, SolverError, format_path
@@ -30,6 +32,7 @@ from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
 from clearsim.model.flexible import flexible_link_names
 from clearsim.model.modes import flexible_modes_attribute, mode_lines
 from clearsim.physics.cylindrical import range_warnings
+from clearsim.physics.lubrication import film_range_warnings
 from clearsim.solver.outputs import (
     classify_episodes, chunk_outputs, full_precision, output_rate, sample_modes, stored_outputs,
 )
@@ -319,14 +322,17 @@ class _PendingChunks:
 
     def law_range_warnings(self) -> list[str]:
         """Each clearance joint's elastic law used outside its range, at the deepest penetration sampled
-        (cylindrical.range_warnings)."""
+        (cylindrical.range_warnings), and each oil film outside its L/D range (lubrication.film_range_warnings)."""
         arrays = self.system.arrays
-        clearance = arrays.clearance_params[:, CL_CLEARANCE]
+        params = arrays.clearance_params
+        clearance = params[:, CL_CLEARANCE]
         peaks = ((np.concatenate(self.paths)[:, :, 2].max(axis=0) - 1.0) * clearance if self.paths
-                 else np.full(len(clearance), np.nan))
+                 else np.full(len(clearance), np.nan)) + params[:, CL_DRY_GAP]
         return [text for k, joint in enumerate(self.system.clearance_joints)
                 for text in range_warnings(joint, arrays.clearance_laws[k, 3], clearance[k],
-                                           arrays.clearance_params[k, CL_STIFFNESS], peaks[k])]
+                                           params[k, CL_STIFFNESS], peaks[k])
+                + film_range_warnings(joint, arrays.clearance_laws[k, LAW_FILM_MODEL], params[k, CL_VISCOSITY],
+                                      params[k, CL_FILM_LENGTH], params[k, CL_JOURNAL_RADIUS])]
 
     def whirls(self) -> dict[str, list]:
         """The whirls of each clearance joint in the samples written (clearsim.whirl)."""

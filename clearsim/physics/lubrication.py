@@ -169,3 +169,28 @@ def film_torque(viscosity, radius, length, clearance, eps, relative_speed):
     over the whole film, ∫dθ/D = 2π/√(1 − ε²) (Petroff 1883 at ε = 0), without the pressure-flow term."""
     return -2.0 * math.pi * viscosity * radius ** 3 * length * relative_speed / (
         clearance * math.sqrt(1.0 - eps * eps))
+
+
+# --- validity ---------------------------------------------------------------------------------------------------
+
+SHORT_BEARING_MAX_RATIO = 0.5  # L/D up to which the short-bearing (Ocvirk) force is a fair approximation
+LONG_BEARING_MIN_RATIO = 2.0  # L/D from which the long-bearing (Sommerfeld) force is
+
+
+def film_range_warnings(joint, model, viscosity, length, journal_radius):
+    """The run summary's warning for joint `joint` (name) whose film model (BEARING_MODELS value) is used at a
+    length-to-diameter ratio L/D outside its range: short bearing above 1/2, long bearing below 2 (both then
+    overestimate the load: the short one's pressure grows as L², the long one ignores the side leakage).
+    None for a dry joint (viscosity 0)."""
+    if viscosity <= 0.0:
+        return []
+    ratio = length / (2.0 * journal_radius)
+    if model == SHORT_BEARING and ratio > SHORT_BEARING_MAX_RATIO:
+        return [f"joint '{joint}': the short_bearing film assumes L/D <= {SHORT_BEARING_MAX_RATIO:g}; L/D = "
+                f"{ratio:.3g} here, so the film force is overestimated (long_bearing holds from L/D = "
+                f"{LONG_BEARING_MIN_RATIO:g})"]
+    if model == LONG_BEARING and ratio < LONG_BEARING_MIN_RATIO:
+        return [f"joint '{joint}': the long_bearing film assumes L/D >= {LONG_BEARING_MIN_RATIO:g}; L/D = "
+                f"{ratio:.3g} here, so the film force is overestimated (short_bearing holds up to L/D = "
+                f"{SHORT_BEARING_MAX_RATIO:g})"]
+    return []

@@ -110,3 +110,13 @@ def test_petroff_torque_at_the_centre_and_its_growth_towards_the_wall():
     assert torque == pytest.approx(-2 * math.pi * MU * R ** 3 * L * 100.0 / C, rel=1e-14)
     assert lub.film_torque(MU, R, L, C, 0.8, 100.0) == pytest.approx(torque / 0.6, rel=1e-14)
     assert lub.film_torque(MU, R, L, C, 0.3, -100.0) == pytest.approx(-lub.film_torque(MU, R, L, C, 0.3, 100.0))
+
+
+def test_range_warnings_name_the_joint_and_the_model_outside_its_length_to_diameter_ratio():
+    assert lub.film_range_warnings("J", lub.SHORT_BEARING, MU, 0.05, 0.05) == []  # L/D = 0.5
+    [text] = lub.film_range_warnings("J", lub.SHORT_BEARING, MU, 0.1, 0.05)  # L/D = 1
+    assert "joint 'J'" in text and "short_bearing" in text and "L/D = 1 " in text
+    assert lub.film_range_warnings("J", lub.LONG_BEARING, MU, 0.2, 0.05) == []  # L/D = 2
+    [text] = lub.film_range_warnings("J", lub.LONG_BEARING, MU, 0.1, 0.05)
+    assert "long_bearing" in text
+    assert lub.film_range_warnings("J", lub.SHORT_BEARING, 0.0, 0.1, 0.05) == []  # a dry joint has no film

@@ -185,3 +185,17 @@ def test_the_dry_modes_ignore_the_oil_and_the_film_mode_carries_it_alone():
     assert np.linalg.norm(thin[:2]) > 0.0 and thin_loss > 0.0
     np.testing.assert_allclose(thick, 10.0 * thin, rtol=1e-12)
     assert thick_loss == pytest.approx(10.0 * thin_loss, rel=1e-12)
+
+
+def test_a_film_model_outside_its_length_to_diameter_ratio_warns_in_the_run_summary(tmp_path):
+    """L = 10 mm, D = 20 mm: L/D = 0.5 suits the short bearing, not the long one."""
+    from typer.testing import CliRunner
+
+    from clearsim.cli import app
+
+    for model, warned in (("short_bearing", False), ("long_bearing", True)):
+        path = tmp_path / f"{model}.yaml"
+        path.write_text(journal(10.0, 0.2, spin=100.0, model=model))
+        result = CliRunner().invoke(app, ["run", str(path), "-o", str(tmp_path / f"{model}.h5")])
+        assert result.exit_code == 0, result.output
+        assert ("long_bearing film assumes L/D >= 2" in " ".join(result.output.split())) == warned, result.output

@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from clearsim.errors import ClearsimError, Problem
-from clearsim.model.schema import PrismaticJoint, SpringDamper, validate_mechanism
+from clearsim.model.schema import TWO_ENDED, PrismaticJoint, validate_mechanism
 from clearsim.units import si_text
 
 
@@ -103,7 +103,7 @@ def _joint_location(mechanism, poses, joint, body: str) -> np.ndarray:
 def _force_ends(poses, force, body: str) -> list[tuple[int, np.ndarray]]:
     """(end index, global location at t = 0) of each end of a force that acts on `body`."""
     index = poses.index[body]
-    if not isinstance(force, SpringDamper):
+    if not isinstance(force, TWO_ENDED):
         return [(0, poses.point_global(force.point, index, ()))] if force.body == body else []
     ends = []
     for end, name in enumerate(force.bodies):

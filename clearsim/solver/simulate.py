@@ -45,7 +45,7 @@ class Chunk:
     """Output samples of one stretch of the run, with everything derived from them."""
 
     times: np.ndarray
-    states: np.ndarray  # (S, 2n + WORK_COUNT): q, q̇, integrated powers
+    states: np.ndarray  # (S, 2n + WORK_COUNT + nz): q, q̇, integrated powers, force elements' states
     modes: np.ndarray  # (S, nc) FREE / CONTACT while the sample's step ran
     impact_speeds: np.ndarray  # (S, nc) δ̇⁻ of the current contact episode
     episodes: np.ndarray  # (S, nc) index into the episode log, −1 in free flight
@@ -209,7 +209,7 @@ class Run:
         self.kernel_arrays = for_kernels(arrays)
         nc = len(system.clearance_joints)
         n = system.coordinate_count
-        self.y = np.concatenate([system.q0, system.qd0, np.zeros(WORK_COUNT)])
+        self.y = np.concatenate([system.q0, system.qd0, np.zeros(WORK_COUNT), system.z0])
         self.f = np.zeros_like(self.y)
         self.modes = np.zeros(nc, np.int64)
         self.speeds = np.zeros(nc)

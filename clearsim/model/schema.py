@@ -372,9 +372,12 @@ class TableValve(Strict):
 
     @field_validator("points")
     @classmethod
-    def _increasing(cls, points):
+    def _increasing_and_opening(cls, points):
         if any(b[0] <= a[0] for a, b in zip(points, points[1:])):
             raise ValueError("the valve table's times must increase from one point to the next")
+        if max(fraction for _, fraction in points) <= 0.0:
+            raise ValueError("the valve table never opens (every fraction is 0): the cylinder would never move; "
+                             "give the opening fraction it reaches (up to 1)")
         return points
 
 
@@ -428,14 +431,6 @@ class HydraulicCylinder(Strict):
     initial_pressures: tuple[Pressure, Pressure] | None = Field(
         None, description="[p_A, p_B] at t = 0; default: each chamber at the pressure its port connects it to at t = 0")
     resisting_force: Force = Field(0.0, ge=0.0, description="the load's force against the extension at t = 0 (a spring's preload): checked against the supply")
-
-    @model_validator(mode="after")
-    def _valve_opens(self):
-        valve = self.valve
-        if isinstance(valve, TableValve) and max(fraction for _, fraction in valve.points) <= 0.0:
-            raise ValueError("the valve table never opens (every fraction is 0): the cylinder would never move; "
-                             "give the opening fraction it reaches (up to 1)")
-        return self
 
 
 AppliedForce = Annotated[Union[ConstantForce, SpringDamper, TabulatedForce, HydraulicCylinder], Field(discriminator="type")]

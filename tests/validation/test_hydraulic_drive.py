@@ -1,0 +1,155 @@
+"""The hydraulic cylinder (docs/model-drives.md "Hydraulic cylinder") against an independent integration of its ODEs.
+
+A 10 kg block on a prismatic guide, held by a 2e5 N/m spring, is pushed by a cylinder fed from a 1 L accumulator at
+100 bar through a valve that opens from 2 to 7 ms; the rod chamber drains to the tank through a port that a cushion
+closes to 10 % over the last 20 mm of the 60 mm stroke. The run crosses the valve's opening, the laminar region of
+the rod port (p_B passes through the tank pressure) and the cushion (the block reaches 48.6 mm).
+"""
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from typer.testing import CliRunner
+
+from clearsim.cli import app
+
+CYLINDER = """
+name: hydraulic cylinder pushing a block against a spring
+points: {O: [0 m, 0 m], C: [-0.5 m, 0 m], W: [-0.6 m, 0 m]}
+bodies:
+  - {name: block, mass: 10 kg, inertia: 0.01 kg*m^2, position: [0 m, 0 m]}
+joints:
+  - {name: guide, type: prismatic, bodies: [ground, block], at: O, axis: [1, 0]}
+forces:
+  - {name: spring, type: spring_damper, bodies: [ground, block], at: [W, O], stiffness: 2e5 N/m}
+  - name: actuator
+    type: hydraulic_cylinder
+    bodies: [ground, block]
+    at: [C, O]
+    stroke: 60 mm
+    piston_area: 10 cm^2
+    rod_side_area: 5 cm^2
+    dead_volumes: [50 cm^3, 50 cm^3]
+    bulk_modulus: 1.4 GPa
+    density: 850 kg/m^3
+    discharge_coefficient: 0.7
+    transition_pressure: 1 bar
+    supply: {type: accumulator, pressure: 100 bar, gas_volume: 1 L, polytropic_index: 1.4}
+    tank_pressure: 0 Pa
+    ports: {piston: valve, rod: tank}
+    port_areas: {piston: 20 mm^2, rod: 20 mm^2}
+    valve: {law: linear, delay: 2 ms, opening_time: 5 ms}
+    cushion: {length: 20 mm, residual_fraction: 0.1}
+sensors:
+  - {name: x, type: point_displacement, body: block, direction: [1, 0]}
+solver: {t_end: 60 ms, output_rate: 10 kHz, rtol: 1e-10, atol: 1e-12, max_step: 1 ms}
+"""
+
+MASS, STIFFNESS = 10.0, 2e5
+AREA_A, AREA_B, STROKE, DEAD_A, DEAD_B = 10e-4, 5e-4, 0.06, 50e-6, 50e-6
+BULK, DENSITY, CD, TRANSITION = 1.4e9, 850.0, 0.7, 1e5
+P0, V0, INDEX, TANK = 100e5, 1e-3, 1.4, 0.0
+PORT_A, PORT_B = 20e-6, 20e-6
+
+
+def flow(pressure_drop, area):
+    """Orifice flow, linear below the transition pressure (written here from the docs' formula)."""
+    gain = CD * area * np.sqrt(2.0 / DENSITY)
+    if abs(pressure_drop) < TRANSITION:
+        return gain * pressure_drop / np.sqrt(TRANSITION)
+    return gain * np.sign(pressure_drop) * np.sqrt(abs(pressure_drop))
+
+
+def opening(t):
+    return min(max((t - 2e-3) / 5e-3, 0.0), 1.0)
+
+
+def cushion(x):
+    return 1.0 - 0.9 * min(max((x - (STROKE - 0.02)) / 0.02, 0.0), 1.0)
+
+
+def reference_rhs(t, state):
+    """[x, v, p_A, p_B, V_gas, orifice loss, oil energy]'."""
+    x, v, pa, pb, gas = state[:5]
+    supply = P0 * (V0 / gas) ** INDEX
+    u = opening(t)
+    in_a, out_a = flow(supply - pa, PORT_A * u), flow(pa - TANK, PORT_A * (1.0 - u))
+    out_b = flow(pb - TANK, PORT_B * cushion(x))
+    net_a, net_b = in_a - out_a - AREA_A * v, -out_b + AREA_B * v
+    loss = in_a * (supply - pa) + out_a * (pa - TANK) + out_b * (pb - TANK)
+    return [v, (pa * AREA_A - pb * AREA_B - STIFFNESS * x) / MASS, BULK / (DEAD_A + AREA_A * x) * net_a,
+            BULK / (DEAD_B + AREA_B * (STROKE - x)) * net_b, in_a, loss, pa * net_a + pb * net_b]
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    from clearsim.io.hdf5 import read_result
+    from clearsim.model.loader import load_mechanism_text
+    from clearsim.runner import prepare, run_to_file
+
+    loaded = load_mechanism_text(CYLINDER)
+    output = tmp_path_factory.mktemp("hydraulic") / "cylinder.h5"
+    report = run_to_file(prepare(loaded), loaded, output)
+    assert report.complete, report.status
+    result = read_result(output)
+    times = result["time"]
+    reference = solve_ivp(reference_rhs, (0.0, times[-1]), [0.0, 0.0, 0.0, 0.0, V0, 0.0, 0.0], method="DOP853",
+                          t_eval=times, rtol=1e-12, atol=[1e-15, 1e-13, 1e-6, 1e-6, 1e-18, 1e-12, 1e-12],
+                          max_step=2e-5)
+    assert reference.success
+    return result, reference.y
+
+
+def within(clearsim, reference, relative=1e-6):
+    """max |clearsim − reference| ≤ relative × max |reference| over the run."""
+    return np.max(np.abs(clearsim - reference)) <= relative * np.max(np.abs(reference))
+
+
+def test_travel_and_pressures_match_an_independent_integration(runs):
+    result, reference = runs
+    x, pa, pb = reference[0], reference[2], reference[3]
+    assert 0.045 < np.max(x) < STROKE and np.min(pb) < TANK  # the cushion and the rod port's laminar region ran
+    assert within(result["sensors/x"], x)
+    assert within(result["drives/actuator/piston_pressure"], pa)
+    assert within(result["drives/actuator/rod_pressure"], pb)
+    assert within(result["drives/actuator/gas_volume"] - V0, reference[4] - V0)
+
+
+def test_the_accumulators_gas_work_closes_the_energy_balance(runs):
+    """Gas work p_0 V_0^n (V^(1−n) − V_0^(1−n))/(1 − n) = kinetic + spring + oil compression + orifice losses."""
+    result, reference = runs
+    gas = result["drives/actuator/gas_volume"]
+    gas_work = P0 * V0**INDEX * (gas ** (1 - INDEX) - V0 ** (1 - INDEX)) / (1 - INDEX)
+    stored = (result["energy/kinetic"] + result["energy/potential"] + result["energy/oil_compression"]
+              + result["energy/orifice_dissipated"])
+    assert np.max(np.abs(stored - gas_work)) <= 1e-6 * np.max(gas_work)
+    assert within(result["energy/hydraulic_supply_work"], gas_work)
+    assert within(result["energy/orifice_dissipated"], reference[5])
+    assert within(result["energy/oil_compression"], reference[6])
+    assert np.max(np.abs(result["energy/balance_error"])) <= 1e-6 * np.max(gas_work)
+
+
+runner = CliRunner()
+
+
+@pytest.mark.parametrize("old, new, place, words", [
+    ("piston_area: 10 cm^2", "piston_area: -10 cm^2", "forces[1] 'actuator' → piston_area", "greater than 0"),
+    ("bulk_modulus: 1.4 GPa", "bulk_modulus: -1.4 GPa", "forces[1] 'actuator' → bulk_modulus", "greater than 0"),
+    ("delay: 2 ms", "delay: 80 ms", "forces[1] 'actuator' → valve", "does not open before the run ends"),
+    ("valve: {law: linear, delay: 2 ms, opening_time: 5 ms}", "valve: {law: table, points: [[0 s, 0], [1 s, 0]]}",
+     "forces[1] 'actuator' → valve", "never opens"),
+    ("tank_pressure: 0 Pa", "tank_pressure: 0 Pa\n    resisting_force: 12 kN", "forces[1] 'actuator' → resisting_force",
+     "cannot extend"),
+    ("bodies: [ground, block]\n    at: [C, O]", "bodies: [block, block]\n    at: [C, O]",
+     "forces[1] 'actuator' → bodies", "connects two different bodies"),
+], ids=["negative area", "negative bulk modulus", "valve opens after the end", "valve never opens",
+        "supply below the load", "one body twice"])
+def test_bad_cylinders_exit_2_with_a_located_message(tmp_path, old, new, place, words):
+    assert old in CYLINDER
+    config = tmp_path / "bad.yaml"
+    config.write_text(CYLINDER.replace(old, new))
+    result = runner.invoke(app, ["run", str(config), "-o", str(tmp_path / "never.h5")])
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    assert place in result.output and words in result.output, result.output
+    assert not (tmp_path / "never.h5").exists()

@@ -32,8 +32,6 @@ PORT_KINDS = {"valve": PORT_VALVE, "supply": PORT_SUPPLY, "tank": PORT_TANK}
 # a cylinder's states, scaled (module docstring)
 Z_PISTON, Z_ROD, Z_GAS = range(3)
 ELEMENT_STATES = 3
-STATE_NAMES = ("piston_pressure", "rod_pressure", "gas_volume")
-STATE_UNITS = ("Pa", "Pa", "m^3")
 
 
 @njit(cache=True)
@@ -246,13 +244,32 @@ def cylinder_row(cylinder, si, sj, length: float, add_law) -> tuple[list[float],
     return row, laws, [piston / reference, rod / reference, 1.0]
 
 
-def state_histories(names: list[str], params: np.ndarray, states: np.ndarray) -> dict:
-    """/drives/<name>/<state> in SI from the scaled states (S, ELEMENT_STATES · cylinders)."""
+def _point_positions(q: np.ndarray, body: int, point) -> np.ndarray:
+    """(S, 2) global positions of a body-fixed point over samples of q (S, n); the ground's point is fixed."""
+    if body < 0:
+        return np.tile(np.asarray(point, float), (q.shape[0], 1))
+    x, y, angle = q[:, 3 * body], q[:, 3 * body + 1], q[:, 3 * body + 2]
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([x + c * point[0] - s * point[1], y + s * point[0] + c * point[1]], axis=1)
+
+
+def drive_histories(names: list[str], bodies: np.ndarray, params: np.ndarray, q: np.ndarray,
+                    states: np.ndarray) -> dict:
+    """/drives/<name>/…: each cylinder's states in SI (from the scaled z, (S, ELEMENT_STATES · cylinders)), its stroke,
+    force and supply pressure, over samples of q (S, n)."""
     out = {}
     for k, name in enumerate(names):
-        scales = (params[k, HY_REFERENCE], params[k, HY_REFERENCE], params[k, HY_GAS_VOLUME])
-        for slot, (state, unit) in enumerate(zip(STATE_NAMES, STATE_UNITS)):
-            if slot == Z_GAS and scales[slot] <= 0.0:
-                continue  # a constant source has no gas
-            out[f"drives/{name}/{state}"] = (states[:, ELEMENT_STATES * k + slot] * scales[slot], unit)
+        p = params[k]
+        z = states[:, ELEMENT_STATES * k:ELEMENT_STATES * (k + 1)]
+        piston, rod = p[HY_REFERENCE] * z[:, Z_PISTON], p[HY_REFERENCE] * z[:, Z_ROD]
+        ends = [_point_positions(q, bodies[k, end], p[column:column + 2])
+                for end, column in ((0, HY_POINT_I), (1, HY_POINT_J))]
+        out[f"drives/{name}/piston_pressure"] = (piston, "Pa")
+        out[f"drives/{name}/rod_pressure"] = (rod, "Pa")
+        out[f"drives/{name}/stroke"] = (np.linalg.norm(ends[1] - ends[0], axis=1) - p[HY_INITIAL_LENGTH], "m")
+        out[f"drives/{name}/force"] = (piston * p[HY_AREA_A] - rod * p[HY_AREA_B], "N")
+        if p[HY_GAS_VOLUME] > 0.0:  # a constant source has no gas
+            gas = z[:, Z_GAS]
+            out[f"drives/{name}/gas_volume"] = (gas * p[HY_GAS_VOLUME], "m^3")
+            out[f"drives/{name}/supply_pressure"] = (p[HY_GAS_PRESSURE] * gas ** -p[HY_POLYTROPIC], "Pa")
     return out

@@ -283,8 +283,10 @@ def chunk_outputs(system: System, chunk, modes: np.ndarray, initial_energy: floa
     joints = ideal_joint_reactions(system, chunk) | clearance_histories(system, chunk, modes)
     out |= joints
     out |= energy_histories(system, chunk, initial_energy)
-    out |= hydraulics.state_histories(system.hydraulic_cylinders, system.arrays.hydraulic_params,
-                                      chunk.states[:, 2 * system.coordinate_count + WORK_COUNT:])
+    n = system.coordinate_count
+    out |= hydraulics.drive_histories(system.hydraulic_cylinders, system.arrays.hydraulic_bodies,
+                                      system.arrays.hydraulic_params, chunk.states[:, :n],
+                                      chunk.states[:, 2 * n + WORK_COUNT:])
     out["constraints/violation"] = (chunk.violation, "m")
     origins = sensor_origins(system)
     for spec in system.sensors:

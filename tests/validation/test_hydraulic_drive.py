@@ -68,36 +68,44 @@ def cushion(x):
     return 1.0 - 0.9 * min(max((x - (STROKE - 0.02)) / 0.02, 0.0), 1.0)
 
 
-def reference_rhs(t, state):
-    """[x, v, p_A, p_B, V_gas, orifice loss, oil energy]'."""
+def reference_rhs(t, state, differential=False):
+    """[x, v, p_A, p_B, V_gas, orifice loss, oil energy]'. Differential: a constant supply P0 feeds the rod chamber
+    permanently and a spring compressed by 25 mm at x = 0 balances its force."""
     x, v, pa, pb, gas = state[:5]
-    supply = P0 * (V0 / gas) ** INDEX
+    supply = P0 if differential else P0 * (V0 / gas) ** INDEX
     u = opening(t)
     in_a, out_a = flow(supply - pa, PORT_A * u), flow(pa - TANK, PORT_A * (1.0 - u))
-    out_b = flow(pb - TANK, PORT_B * cushion(x))
-    net_a, net_b = in_a - out_a - AREA_A * v, -out_b + AREA_B * v
-    loss = in_a * (supply - pa) + out_a * (pa - TANK) + out_b * (pb - TANK)
-    return [v, (pa * AREA_A - pb * AREA_B - STIFFNESS * x) / MASS, BULK / (DEAD_A + AREA_A * x) * net_a,
-            BULK / (DEAD_B + AREA_B * (STROKE - x)) * net_b, in_a, loss, pa * net_a + pb * net_b]
+    port_b = flow(supply - pb, PORT_B * cushion(x)) if differential else -flow(pb - TANK, PORT_B * cushion(x))
+    net_a, net_b = in_a - out_a - AREA_A * v, port_b + AREA_B * v
+    loss = in_a * (supply - pa) + out_a * (pa - TANK) + (port_b * (supply - pb) if differential else -port_b * pb)
+    spring = STIFFNESS * (x - (0.025 if differential else 0.0))
+    return [v, (pa * AREA_A - pb * AREA_B - spring) / MASS, BULK / (DEAD_A + AREA_A * x) * net_a,
+            BULK / (DEAD_B + AREA_B * (STROKE - x)) * net_b, in_a + (port_b if differential else 0.0), loss,
+            pa * net_a + pb * net_b]
 
 
-@pytest.fixture(scope="module")
-def runs(tmp_path_factory):
+def run_and_reference(text, folder, differential=False):
+    """(clearsim's result, solve_ivp's [x, v, p_A, p_B, V_gas, orifice loss, oil energy] at its sample times)."""
     from clearsim.io.hdf5 import read_result
     from clearsim.model.loader import load_mechanism_text
     from clearsim.runner import prepare, run_to_file
 
-    loaded = load_mechanism_text(CYLINDER)
-    output = tmp_path_factory.mktemp("hydraulic") / "cylinder.h5"
+    loaded = load_mechanism_text(text)
+    output = folder / "cylinder.h5"
     report = run_to_file(prepare(loaded), loaded, output)
     assert report.complete, report.status
     result = read_result(output)
     times = result["time"]
-    reference = solve_ivp(reference_rhs, (0.0, times[-1]), [0.0, 0.0, 0.0, 0.0, V0, 0.0, 0.0], method="DOP853",
-                          t_eval=times, rtol=1e-12, atol=[1e-15, 1e-13, 1e-6, 1e-6, 1e-18, 1e-12, 1e-12],
-                          max_step=2e-5)
+    start = [0.0, 0.0, 0.0, P0 if differential else 0.0, V0, 0.0, 0.0]
+    reference = solve_ivp(reference_rhs, (0.0, times[-1]), start, method="DOP853", t_eval=times, rtol=1e-12,
+                          atol=[1e-15, 1e-13, 1e-6, 1e-6, 1e-18, 1e-12, 1e-12], max_step=2e-5, args=(differential,))
     assert reference.success
     return result, reference.y
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    return run_and_reference(CYLINDER, tmp_path_factory.mktemp("hydraulic"))
 
 
 def within(clearsim, reference, relative=1e-6):
@@ -110,6 +118,9 @@ def test_travel_and_pressures_match_an_independent_integration(runs):
     x, pa, pb = reference[0], reference[2], reference[3]
     assert 0.045 < np.max(x) < STROKE and np.min(pb) < TANK  # the cushion and the rod port's laminar region ran
     assert within(result["sensors/x"], x)
+    assert within(result["drives/actuator/stroke"], x)  # the cylinder's length at t = 0 is its stroke's zero
+    assert within(result["drives/actuator/force"], pa * AREA_A - pb * AREA_B)
+    assert within(result["drives/actuator/supply_pressure"], P0 * (V0 / reference[4]) ** INDEX)
     assert within(result["drives/actuator/piston_pressure"], pa)
     assert within(result["drives/actuator/rod_pressure"], pb)
     assert within(result["drives/actuator/gas_volume"] - V0, reference[4] - V0)
@@ -127,6 +138,27 @@ def test_the_accumulators_gas_work_closes_the_energy_balance(runs):
     assert within(result["energy/orifice_dissipated"], reference[5])
     assert within(result["energy/oil_compression"], reference[6])
     assert np.max(np.abs(result["energy/balance_error"])) <= 1e-6 * np.max(gas_work)
+
+
+DIFFERENTIAL = (CYLINDER.replace("stiffness: 2e5 N/m}", "stiffness: 2e5 N/m, free_length: 625 mm}")
+                .replace("{type: accumulator, pressure: 100 bar, gas_volume: 1 L, polytropic_index: 1.4}",
+                         "{type: constant, pressure: 100 bar}")
+                .replace("rod: tank}", "rod: supply}"))
+
+
+def test_a_differential_circuit_from_a_constant_source_matches_an_independent_integration(tmp_path):
+    """The rod chamber at the supply for good (its cushioned port now lets oil back into the supply), the piston
+    chamber switched from tank to supply by the valve: F = p_s (A_A − A_B) once open."""
+    result, reference = run_and_reference(DIFFERENTIAL, tmp_path, differential=True)
+    x, pa, pb = reference[0], reference[2], reference[3]
+    assert np.max(x) > 0.045  # through the cushion
+    assert within(result["drives/actuator/stroke"], x)
+    assert within(result["drives/actuator/piston_pressure"], pa)
+    assert within(result["drives/actuator/rod_pressure"], pb)
+    assert "drives/actuator/gas_volume" not in result  # a constant source has no gas
+    supplied = result["energy/hydraulic_supply_work"]
+    assert within(result["energy/orifice_dissipated"], reference[5])
+    assert np.max(np.abs(result["energy/balance_error"])) <= 1e-6 * np.max(supplied)
 
 
 runner = CliRunner()

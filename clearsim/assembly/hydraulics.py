@@ -2,7 +2,7 @@
 
 A cylinder between point i (barrel end) and point j (rod end) pushes them apart with F = p_A A_A − p_B A_B along
 u = (P_j − P_i)/ℓ. Its stroke is s = ℓ − ℓ0, its chambers hold V_A = V_A0 + A_A s and V_B = V_B0 + A_B (S − s) of oil,
-and each pressure follows ṗ = β/V (Q_in − V̇) (Merritt 1967, §3.4). Each chamber's port is an orifice to the supply,
+and each pressure follows ṗ = β/V (Q_in − V̇) (Merritt, Hydraulic Control Systems, 1967). Each chamber's port is an orifice to the supply,
 to the tank, or through a 3/2-way valve to both; an accumulator's gas obeys p V_g^n = p_0 V_0^n.
 
 The states of cylinder k are the slots ELEMENT_STATES·k + Z_* of z (the end of the solver's y): the two pressures

@@ -421,7 +421,7 @@ class HydraulicCylinder(Strict):
     bulk_modulus: Pressure = Field(1.4e9, gt=0.0, description="oil bulk modulus β")
     density: Density = Field(850.0, gt=0.0, description="oil density ρ")
     discharge_coefficient: float = Field(0.7, gt=0.0, le=1.0, description="orifice discharge coefficient C_d")
-    transition_pressure: Pressure = Field(1e5, gt=0.0, description="p_tr: below this |Δp| the orifice flow is linear in Δp (laminar)")
+    transition_pressure: Pressure = Field(2e5, gt=0.0, description="p_tr: below this |Δp| the orifice flow is linear in Δp (laminar)")
     supply: Supply = Field(description="the pressure source: an accumulator or a constant pressure")
     tank_pressure: Pressure = Field(0.0, ge=0.0, description="return (tank) pressure p_T")
     ports: ChamberPorts = Field(default_factory=ChamberPorts, description="what each chamber connects to")

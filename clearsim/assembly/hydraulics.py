@@ -168,9 +168,11 @@ def cushion_points(cylinder) -> list[tuple[float, float]]:
 
 
 def port_pressure(kind: str, opening: float, supply: float, tank: float) -> float:
-    """The pressure a port holds a chamber at in equilibrium, with the valve `opening` (Pa)."""
+    """The pressure a port holds a still chamber at (Pa). Through a valve opened by u the flows in, ∝ u √(p_s − p),
+    and out, ∝ (1 − u) √(p − p_T), balance at p = (u² p_s + (1 − u)² p_T)/(u² + (1 − u)²)."""
     if kind == "valve":
-        return supply if opening >= 1.0 else (tank if opening <= 0.0 else tank + (supply - tank) * opening)
+        inlet, outlet = opening**2, (1.0 - opening) ** 2
+        return (inlet * supply + outlet * tank) / (inlet + outlet)
     return supply if kind == "supply" else tank
 
 

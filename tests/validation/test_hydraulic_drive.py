@@ -194,3 +194,12 @@ def test_bad_cylinders_exit_2_with_a_located_message(tmp_path, old, new, place, 
     assert "Traceback" not in result.output
     assert place in result.output and words in result.output, result.output
     assert not (tmp_path / "never.h5").exists()
+
+
+@pytest.mark.parametrize("opening", [0.0, 0.25, 0.5, 0.9, 1.0])
+def test_a_valve_ports_initial_pressure_balances_its_two_flows(opening):
+    from clearsim.assembly.hydraulics import port_pressure
+
+    pressure = port_pressure("valve", opening, P0, 2e5)
+    inflow, outflow = flow(P0 - pressure, PORT_A * opening), flow(pressure - 2e5, PORT_A * (1.0 - opening))
+    assert 2e5 <= pressure <= P0 and inflow == pytest.approx(outflow, rel=1e-12, abs=1e-18)

@@ -155,7 +155,9 @@ def linear_law(points) -> motion.PiecewisePolynomial:
 
 
 def valve_points(valve) -> list[tuple[float, float]]:
-    """The valve law as [time, opening] points."""
+    """The valve law as [time, opening] points (a cylinder without a valve: closed for good)."""
+    if valve is None:
+        return [(0.0, 0.0), (1.0, 0.0)]
     if valve.law == "linear":
         return [(valve.delay, 0.0), (valve.delay + valve.opening_time, 1.0)]
     return [tuple(point) for point in valve.points]
@@ -207,7 +209,7 @@ def build_problems(cylinder, length: float, t_end: float, path: tuple) -> list[P
     """What makes a cylinder unable to run: a valve that does not open before t_end, a supply that cannot overcome the
     stated resisting force, a stroke at t = 0 outside [0, S], an empty chamber."""
     problems = []
-    if opening_time(cylinder.valve) >= t_end:
+    if cylinder.valve is not None and opening_time(cylinder.valve) >= t_end:
         problems.append(Problem(path + ("valve",), f"the valve does not open before the run ends (t_end = {t_end:g} s): "
                                 "the cylinder would never move", "open it earlier (its delay or table) or run longer"))
     force = open_force(cylinder)
@@ -239,7 +241,7 @@ def cylinder_row(cylinder, si, sj, length: float, add_law) -> tuple[list[float],
            cylinder.tank_pressure, supply.pressure, supply.gas_volume if accumulator else 0.0,
            supply.polytropic_index if accumulator else 1.0, cylinder.port_areas.piston, cylinder.port_areas.rod,
            reference]
-    laws = [add_law(linear_law(valve_points(cylinder.valve))),
+    laws = [add_law(linear_law(valve_points(cylinder.valve))) if cylinder.valve is not None else -1,
             add_law(linear_law(cushion_points(cylinder))) if cylinder.cushion is not None else -1,
             PORT_KINDS[cylinder.ports.piston], PORT_KINDS[cylinder.ports.rod]]
     piston, rod = initial_pressures(cylinder)

@@ -211,6 +211,7 @@ def initial_tensions(document: dict, splits: list[LinkSplit], base_dir) -> list[
     from clearsim.assembly.arrays import for_kernels
     from clearsim.assembly.build import BuildError
     from clearsim.assembly.dynamics import accelerations, generalized_forces
+    from clearsim.assembly.hydraulics import add_hydraulic_forces
     from clearsim.assembly.system import assemble
 
     locked = copy.deepcopy(document)
@@ -227,6 +228,7 @@ def initial_tensions(document: dict, splits: list[LinkSplit], base_dir) -> list[
     free = np.zeros(len(system.clearance_joints), np.int64)  # every journal starts in free flight (mode FREE)
     kernel_arrays = for_kernels(system.arrays)
     forces = generalized_forces(kernel_arrays, 0.0, system.q0, system.qd0, free, np.zeros(free.size))[0]
+    add_hydraulic_forces(kernel_arrays, system.q0, system.z0, forces)
     multipliers = accelerations(kernel_arrays, 0.0, system.q0, system.qd0, forces, free)[1]
     return [float(multipliers[dict(system.drivers)[lock]]) for lock in locks]
 

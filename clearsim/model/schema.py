@@ -426,11 +426,18 @@ class HydraulicCylinder(Strict):
     tank_pressure: Pressure = Field(0.0, ge=0.0, description="return (tank) pressure p_T")
     ports: ChamberPorts = Field(default_factory=ChamberPorts, description="what each chamber connects to")
     port_areas: PortAreas = Field(description="fully open orifice area of each chamber's port")
-    valve: ValveLaw = Field(description="opening of the valve a_v(t)/a_max")
+    valve: ValveLaw | None = Field(None, description="opening of the valve a_v(t)/a_max; needed when a port is `valve`")
     cushion: Cushion | None = Field(None, description="end-of-stroke cushion on the rod chamber's port; absent: none")
     initial_pressures: tuple[Pressure, Pressure] | None = Field(
         None, description="[p_A, p_B] at t = 0; default: each chamber at the pressure its port connects it to at t = 0")
     resisting_force: Force = Field(0.0, ge=0.0, description="the load's force against the extension at t = 0 (a spring's preload): checked against the supply")
+
+    @model_validator(mode="after")
+    def _valve_where_a_port_needs_it(self):
+        if self.valve is None and "valve" in (self.ports.piston, self.ports.rod):
+            raise ValueError("a port connects through the valve (`ports: … valve`) but the cylinder has no `valve:` "
+                             "law: give one, e.g. `valve: {law: linear, delay: 0 ms, opening_time: 5 ms}`")
+        return self
 
 
 AppliedForce = Annotated[Union[ConstantForce, SpringDamper, TabulatedForce, HydraulicCylinder], Field(discriminator="type")]

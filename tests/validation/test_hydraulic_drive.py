@@ -183,8 +183,9 @@ runner = CliRunner()
      "cannot extend"),
     ("bodies: [ground, block]\n    at: [C, O]", "bodies: [block, block]\n    at: [C, O]",
      "forces[1] 'actuator' → bodies", "connects two different bodies"),
+    ("    valve: {law: linear, delay: 2 ms, opening_time: 5 ms}\n", "", "forces[1] 'actuator'", "has no `valve:` law"),
 ], ids=["negative area", "negative bulk modulus", "valve opens after the end", "valve never opens",
-        "supply below the load", "one body twice"])
+        "supply below the load", "one body twice", "valve port without a valve"])
 def test_bad_cylinders_exit_2_with_a_located_message(tmp_path, old, new, place, words):
     assert old in CYLINDER
     config = tmp_path / "bad.yaml"
@@ -203,3 +204,29 @@ def test_a_valve_ports_initial_pressure_balances_its_two_flows(opening):
     pressure = port_pressure("valve", opening, P0, 2e5)
     inflow, outflow = flow(P0 - pressure, PORT_A * opening), flow(pressure - 2e5, PORT_A * (1.0 - opening))
     assert 2e5 <= pressure <= P0 and inflow == pytest.approx(outflow, rel=1e-12, abs=1e-18)
+
+
+def test_a_flexible_link_starts_carrying_the_cylinders_force(simulate):
+    """A cylinder with both chambers on a constant 100 bar source pushes with p_s (A_A − A_B) = 1 kN from t = 0 on the
+    tip of an axial flexible link (k = 4e5 N/m): the link starts compressed by that force, so nothing moves
+    (started unloaded it would ring with 2.5 mm amplitude)."""
+    from tests.validation.test_flexible_axial import mass_on_link
+
+    cylinder = """forces:
+  - name: actuator
+    type: hydraulic_cylinder
+    bodies: [ground, tip]
+    at: [[1.0, 0], [0.5, 0]]
+    stroke: 0.1
+    piston_area: 2e-4
+    rod_side_area: 1e-4
+    dead_volumes: [1e-5, 1e-5]
+    supply: {type: constant, pressure: 1e7}
+    ports: {piston: supply, rod: supply}
+    port_areas: {piston: 1e-6, rod: 1e-6}
+    initial_length: 0.45
+"""
+    text = mass_on_link(periods=10).replace("forces:\n", cylinder)
+    result = simulate(text)
+    assert result["drives/actuator/force"][0] == pytest.approx(1000.0, rel=1e-12)
+    assert np.max(np.abs(result["sensors/stretch"])) <= 1e-9

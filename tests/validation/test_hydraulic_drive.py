@@ -230,3 +230,16 @@ def test_a_flexible_link_starts_carrying_the_cylinders_force(simulate):
     result = simulate(text)
     assert result["drives/actuator/force"][0] == pytest.approx(1000.0, rel=1e-12)
     assert np.max(np.abs(result["sensors/stretch"])) <= 1e-9
+
+
+def test_the_energy_page_shows_the_hydraulic_energies(tmp_path):
+    from clearsim.model.loader import load_mechanism_text
+    from clearsim.plot import load_run
+    from clearsim.plot.history import plot_energies
+    from clearsim.runner import prepare, run_to_file
+
+    loaded = load_mechanism_text(CYLINDER.replace("t_end: 60 ms", "t_end: 20 ms"))
+    run_to_file(prepare(loaded), loaded, tmp_path / "cylinder.h5")
+    ax = plot_energies(load_run(tmp_path / "cylinder.h5"))
+    labels = {line.get_label() for line in ax.get_lines()}
+    assert {"hydraulic supply work", "orifice dissipated", "oil compression"} <= labels, labels

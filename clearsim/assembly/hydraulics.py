@@ -2,8 +2,8 @@
 
 A cylinder between point i (barrel end) and point j (rod end) pushes them apart with F = p_A A_A − p_B A_B along
 u = (P_j − P_i)/ℓ. Its stroke is s = ℓ − ℓ0, its chambers hold V_A = V_A0 + A_A s and V_B = V_B0 + A_B (S − s) of oil,
-and each pressure follows ṗ = β/V (Q_in − V̇) (Merritt, Hydraulic Control Systems, 1967). Each chamber's port is an orifice to the supply,
-to the tank, or through a 3/2-way valve to both; an accumulator's gas obeys p V_g^n = p_0 V_0^n.
+and each pressure follows ṗ = β/V (Q_in − V̇) (Merritt, Hydraulic Control Systems, 1967). Each chamber's port is an
+orifice to the supply, to the tank, or through a 3/2-way valve to both; an accumulator's gas obeys p V_g^n = p_0 V_0^n.
 
 The states of cylinder k are the slots ELEMENT_STATES·k + Z_* of z (the end of the solver's y): the two pressures
 over the reference pressure p_ref (the supply's at t = 0) and the gas volume over V_0, so that every state is of
@@ -144,16 +144,6 @@ def hydraulic_rates(system, t, q, qd, z, zdot):
 # --- the Python side: from the YAML's cylinder to its row of the arrays -----------------------------
 
 
-def linear_law(points) -> motion.PiecewisePolynomial:
-    """The polyline through [(x, value), ...] (x increasing), held at its end values outside them."""
-    xs = np.array([x for x, _ in points], float)
-    values = np.array([v for _, v in points], float)
-    slopes = np.diff(values) / np.diff(xs)
-    pieces = [motion._pad([values[0]])] + [motion._pad([v, slope]) for v, slope in zip(values[:-1], slopes)]
-    pieces.append(motion._pad([values[-1]]))
-    return motion.PiecewisePolynomial(np.concatenate([[xs[0] - 1.0], xs]), np.array(pieces))
-
-
 def valve_points(valve) -> list[tuple[float, float]]:
     """The valve law as [time, opening] points (a cylinder without a valve: closed for good)."""
     if valve is None:
@@ -205,29 +195,42 @@ def open_force(cylinder) -> float:
     return piston * cylinder.piston_area - rod * cylinder.rod_side_area
 
 
+def _valve_problems(cylinder, t_end: float, path: tuple) -> list[Problem]:
+    if cylinder.valve is None or opening_time(cylinder.valve) < t_end:
+        return []
+    return [Problem(path + ("valve",), f"the valve does not open before the run ends (t_end = {t_end:g} s): the "
+                    "cylinder would never move", "open it earlier (its delay or table) or run longer")]
+
+
+def _supply_problems(cylinder, path: tuple) -> list[Problem]:
+    force = open_force(cylinder)
+    if force > cylinder.resisting_force:
+        return []
+    return [Problem(path + ("resisting_force",),
+                    f"the supply ({cylinder.supply.pressure:.4g} Pa) pushes with at most {force:.4g} N with the valve "
+                    f"open (p_A A_A − p_B A_B), not more than the resisting force {cylinder.resisting_force:.4g} N: the "
+                    "cylinder cannot extend", "raise the supply pressure or the piston area, or check the areas' units")]
+
+
+def _stroke_problems(cylinder, length: float, path: tuple) -> list[Problem]:
+    start = length - (cylinder.initial_length if cylinder.initial_length is not None else length)
+    if 0.0 <= start <= cylinder.stroke:
+        return []
+    return [Problem(path + ("initial_length",), f"the stroke at t = 0 is {start:.4g} m, outside 0 … "
+                    f"{cylinder.stroke:g} m", "state the length at which the stroke is 0")]
+
+
+def _volume_problems(cylinder, path: tuple) -> list[Problem]:
+    return [Problem(path + ("dead_volumes", index), f"a chamber's dead volume must be positive, got {volume:g} m^3",
+                    "give the oil volume left in the chamber at its stroke's end")
+            for index, volume in enumerate(cylinder.dead_volumes) if volume <= 0.0]
+
+
 def build_problems(cylinder, length: float, t_end: float, path: tuple) -> list[Problem]:
     """What makes a cylinder unable to run: a valve that does not open before t_end, a supply that cannot overcome the
     stated resisting force, a stroke at t = 0 outside [0, S], an empty chamber."""
-    problems = []
-    if cylinder.valve is not None and opening_time(cylinder.valve) >= t_end:
-        problems.append(Problem(path + ("valve",), f"the valve does not open before the run ends (t_end = {t_end:g} s): "
-                                "the cylinder would never move", "open it earlier (its delay or table) or run longer"))
-    force = open_force(cylinder)
-    if force <= cylinder.resisting_force:
-        problems.append(Problem(
-            path + ("resisting_force",),
-            f"the supply ({cylinder.supply.pressure:.4g} Pa) pushes with at most {force:.4g} N with the valve open "
-            f"(p_A A_A − p_B A_B), not more than the resisting force {cylinder.resisting_force:.4g} N: the cylinder "
-            "cannot extend", "raise the supply pressure or the piston area, or check the areas' units"))
-    start = length - (cylinder.initial_length if cylinder.initial_length is not None else length)
-    if not 0.0 <= start <= cylinder.stroke:
-        problems.append(Problem(path + ("initial_length",), f"the stroke at t = 0 is {start:.4g} m, outside 0 … "
-                                f"{cylinder.stroke:g} m", "state the length at which the stroke is 0"))
-    for index, volume in enumerate(cylinder.dead_volumes):
-        if volume <= 0.0:
-            problems.append(Problem(path + ("dead_volumes", index), f"a chamber's dead volume must be positive, "
-                                    f"got {volume:g} m^3", "give the oil volume left in the chamber at its stroke's end"))
-    return problems
+    return (_valve_problems(cylinder, t_end, path) + _supply_problems(cylinder, path)
+            + _stroke_problems(cylinder, length, path) + _volume_problems(cylinder, path))
 
 
 def cylinder_row(cylinder, si, sj, length: float, add_law) -> tuple[list[float], list[int], list[float]]:
@@ -241,8 +244,8 @@ def cylinder_row(cylinder, si, sj, length: float, add_law) -> tuple[list[float],
            cylinder.tank_pressure, supply.pressure, supply.gas_volume if accumulator else 0.0,
            supply.polytropic_index if accumulator else 1.0, cylinder.port_areas.piston, cylinder.port_areas.rod,
            reference]
-    laws = [add_law(linear_law(valve_points(cylinder.valve))) if cylinder.valve is not None else -1,
-            add_law(linear_law(cushion_points(cylinder))) if cylinder.cushion is not None else -1,
+    laws = [add_law(motion.polyline_law(valve_points(cylinder.valve))) if cylinder.valve is not None else -1,
+            add_law(motion.polyline_law(cushion_points(cylinder))) if cylinder.cushion is not None else -1,
             PORT_KINDS[cylinder.ports.piston], PORT_KINDS[cylinder.ports.rod]]
     piston, rod = initial_pressures(cylinder)
     return row, laws, [piston / reference, rod / reference, 1.0]

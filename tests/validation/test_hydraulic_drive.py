@@ -184,8 +184,12 @@ runner = CliRunner()
     ("bodies: [ground, block]\n    at: [C, O]", "bodies: [block, block]\n    at: [C, O]",
      "forces[1] 'actuator' → bodies", "connects two different bodies"),
     ("    valve: {law: linear, delay: 2 ms, opening_time: 5 ms}\n", "", "forces[1] 'actuator'", "has no `valve:` law"),
+    ("stroke: 60 mm", "stroke: 60 mm\n    initial_length: 0.2 m", "forces[1] 'actuator' → initial_length",
+     "the stroke at t = 0 is 0.3 m, outside 0 … 0.06 m"),
+    ("dead_volumes: [50 cm^3, 50 cm^3]", "dead_volumes: [50 cm^3, 0 cm^3]", "forces[1] 'actuator' → dead_volumes[1]",
+     "dead volume must be positive"),
 ], ids=["negative area", "negative bulk modulus", "valve opens after the end", "valve never opens",
-        "supply below the load", "one body twice", "valve port without a valve"])
+        "supply below the load", "one body twice", "valve port without a valve", "stroke outside", "empty chamber"])
 def test_bad_cylinders_exit_2_with_a_located_message(tmp_path, old, new, place, words):
     assert old in CYLINDER
     config = tmp_path / "bad.yaml"

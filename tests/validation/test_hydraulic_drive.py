@@ -3,7 +3,9 @@
 A 10 kg block on a prismatic guide, held by a 2e5 N/m spring, is pushed by a cylinder fed from a 1 L accumulator at
 100 bar through a valve that opens from 2 to 7 ms; the rod chamber drains to the tank through a port that a cushion
 closes to 10 % over the last 20 mm of the 60 mm stroke. The run crosses the valve's opening, the laminar region of
-the rod port (p_B passes through the tank pressure) and the cushion (the block reaches 48.6 mm).
+the rod port (p_B passes through the tank pressure) and the cushion (the block reaches 48.6 mm). Also: the same
+against a differential circuit from a constant source, the pressures' error control, bad cylinders (exit 2 at their
+key), a valve port's initial pressure, a flexible link under a cylinder at t = 0, the energy page.
 """
 
 import numpy as np

@@ -156,7 +156,9 @@ def valve_points(valve) -> list[tuple[float, float]]:
 def cushion_points(cylinder) -> list[tuple[float, float]]:
     """The cushion as [stroke, open fraction] points."""
     cushion = cylinder.cushion
-    return [(cylinder.stroke - cushion.length, 1.0), (cylinder.stroke, cushion.residual_fraction)]
+    if cushion.law == "linear":
+        return [(cylinder.stroke - cushion.length, 1.0), (cylinder.stroke, cushion.residual_fraction)]
+    return [tuple(point) for point in cushion.points]
 
 
 def port_pressure(kind: str, opening: float, supply: float, tank: float) -> float:

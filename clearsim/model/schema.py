@@ -363,6 +363,12 @@ class LinearValve(Strict):
     opening_time: Time = Field(gt=0.0, description="time t_o from closed to fully open")
 
 
+def _increasing_abscissae(points: list, what: str) -> list:
+    if any(b[0] <= a[0] for a, b in zip(points, points[1:])):
+        raise ValueError(f"the {what} table's first column must increase from one point to the next")
+    return points
+
+
 class TableValve(Strict):
     """Opening a_v/a_max linear between the listed [t, fraction] points, held before the first and after the last."""
 
@@ -373,8 +379,7 @@ class TableValve(Strict):
     @field_validator("points")
     @classmethod
     def _increasing_and_opening(cls, points):
-        if any(b[0] <= a[0] for a, b in zip(points, points[1:])):
-            raise ValueError("the valve table's times must increase from one point to the next")
+        _increasing_abscissae(points, "valve")
         if max(fraction for _, fraction in points) <= 0.0:
             raise ValueError("the valve table never opens (every fraction is 0): the cylinder would never move; "
                              "give the opening fraction it reaches (up to 1)")
@@ -384,12 +389,26 @@ class TableValve(Strict):
 ValveLaw = Annotated[Union[LinearValve, TableValve], Field(discriminator="law")]
 
 
-class Cushion(Strict):
+class LinearCushion(Strict):
     """End-of-stroke cushion: the rod chamber's port area falls linearly from 1 to `residual_fraction` of itself
     over the last `length` of the stroke (the rod chamber empties as the cylinder extends)."""
 
+    law: Literal["linear"] = Field(description="cushion law")
     length: Length = Field(gt=0.0, description="stroke length L_c over which the cushion closes, before the stroke's end")
     residual_fraction: float = Field(gt=0.0, le=1.0, description="port area left at the stroke's end, as a fraction of the open area")
+
+
+class TableCushion(Strict):
+    """The rod chamber's open port fraction linear between the listed [stroke, fraction] points, held outside them."""
+
+    law: Literal["table"] = Field(description="cushion law")
+    points: list[tuple[Length, Annotated[float, Field(ge=0.0, le=1.0)]]] = Field(
+        min_length=2, description="[stroke s, open fraction 0..1] pairs, strokes increasing")
+
+    _increasing = field_validator("points")(lambda points: _increasing_abscissae(points, "cushion"))
+
+
+CushionLaw = Annotated[Union[LinearCushion, TableCushion], Field(discriminator="law")]
 
 
 class ChamberPorts(Strict):
@@ -427,7 +446,7 @@ class HydraulicCylinder(Strict):
     ports: ChamberPorts = Field(default_factory=ChamberPorts, description="what each chamber connects to")
     port_areas: PortAreas = Field(description="fully open orifice area of each chamber's port")
     valve: ValveLaw | None = Field(None, description="opening of the valve a_v(t)/a_max; needed when a port is `valve`")
-    cushion: Cushion | None = Field(None, description="end-of-stroke cushion on the rod chamber's port; absent: none")
+    cushion: CushionLaw | None = Field(None, description="end-of-stroke cushion on the rod chamber's port; absent: none")
     initial_pressures: tuple[Pressure, Pressure] | None = Field(
         None, description="[p_A, p_B] at t = 0; default: each chamber at the pressure its port connects it to at t = 0")
     resisting_force: Force = Field(0.0, ge=0.0, description="the load's force against the extension at t = 0 (a spring's preload): checked against the supply")

@@ -41,7 +41,7 @@ forces:
     ports: {piston: valve, rod: tank}
     port_areas: {piston: 20 mm^2, rod: 20 mm^2}
     valve: {law: linear, delay: 2 ms, opening_time: 5 ms}
-    cushion: {length: 20 mm, residual_fraction: 0.1}
+    cushion: {law: linear, length: 20 mm, residual_fraction: 0.1}
 sensors:
   - {name: x, type: point_displacement, body: block, direction: [1, 0]}
 solver: {t_end: 60 ms, output_rate: 10 kHz, rtol: 1e-10, atol: 1e-12, max_step: 1 ms}
@@ -126,6 +126,19 @@ def test_travel_and_pressures_match_an_independent_integration(runs):
     assert within(result["drives/actuator/piston_pressure"], pa)
     assert within(result["drives/actuator/rod_pressure"], pb)
     assert within(result["drives/actuator/gas_volume"] - V0, reference[4] - V0)
+
+
+def test_a_tabulated_cushion_through_the_same_points_is_the_linear_one(runs, tmp_path):
+    from clearsim.io.hdf5 import read_result
+    from clearsim.model.loader import load_mechanism_text
+    from clearsim.runner import prepare, run_to_file
+
+    table = CYLINDER.replace("{law: linear, length: 20 mm, residual_fraction: 0.1}",
+                             "{law: table, points: [[40 mm, 1], [60 mm, 0.1]]}")
+    loaded = load_mechanism_text(table)
+    run_to_file(prepare(loaded), loaded, tmp_path / "table.h5")
+    stroke = read_result(tmp_path / "table.h5")["drives/actuator/stroke"]
+    assert within(stroke, runs[0]["drives/actuator/stroke"], relative=1e-9)  # S − L_c = 0.06 − 0.02 is not 0.04 in floating point
 
 
 def test_the_accumulators_gas_work_closes_the_energy_balance(runs):

@@ -91,6 +91,8 @@ DIMENSIONS = {
     "force": Dimension("force", "N", _dims(mass=1, length=1, time=-2), "100 N"),
     "torque": Dimension("torque", "N*m", _dims(mass=1, length=2, time=-2), "20 N*m"),
     "area": Dimension("area", "m^2", _dims(length=2), "3.1e-3 m^2"),
+    "volume": Dimension("volume", "m^3", _dims(length=3), "0.5 L"),
+    "density": Dimension("density", "kg/m^3", _dims(mass=1, length=-3), "850 kg/m^3"),
     "pressure": Dimension("pressure (modulus)", "Pa", _dims(mass=1, length=-1, time=-2), "207 GPa"),
     "spring_stiffness": Dimension("spring stiffness", "N/m", _dims(mass=1, time=-2), "1e5 N/m"),
     "damping": Dimension("damping coefficient", "N*s/m", _dims(mass=1, time=-1), "50 N*s/m"),
@@ -108,6 +110,8 @@ DERIVED_UNITS = {  # the other kinds, built from the base ones unless the block 
     "inertia": "{mass}*{length}^2",
     "torque": "{force}*{length}",
     "area": "{length}^2",
+    "volume": "{length}^3",
+    "density": "{mass}/{length}^3",
     "pressure": "{force}/{length}^2",
     "spring_stiffness": "{force}/{length}",
     "damping": "{force}*{time}/{length}",
@@ -409,6 +413,8 @@ Force = _quantity_type("force")
 Torque = _quantity_type("torque")
 Area = _quantity_type("area")
 Pressure = _quantity_type("pressure")
+Volume = _quantity_type("volume")
+Density = _quantity_type("density")
 SpringStiffness = _quantity_type("spring_stiffness")
 Damping = _quantity_type("damping")
 Viscosity = _quantity_type("viscosity")

@@ -57,6 +57,9 @@ OFF_VALUE = 6  # c0
 LOAD_COLUMNS = 5
 # columns of spring_params: point i (2), point j (2), stiffness, damping, free length, preload
 SPRING_COLUMNS = 8
+# columns of hydraulic_params and hydraulic_laws: clearsim/assembly/hydraulics.py HY_*, HL_*
+HYDRAULIC_COLUMNS = 20
+HYDRAULIC_LAW_COLUMNS = 4
 
 SystemArrays = namedtuple(
     "SystemArrays",
@@ -69,7 +72,10 @@ SystemArrays = namedtuple(
         "clearance_bodies", "clearance_laws", "clearance_params",
         "load_bodies", "load_params", "load_law",
         "spring_bodies", "spring_params",
+        "hydraulic_bodies", "hydraulic_params", "hydraulic_laws",
     ],
+    # force elements with states (assembly/hydraulics.py): none unless given
+    defaults=(np.zeros((0, 2), np.int64), np.zeros((0, HYDRAULIC_COLUMNS)), np.zeros((0, HYDRAULIC_LAW_COLUMNS), np.int64)),
 )
 
 

@@ -7,7 +7,9 @@ q̈ = M⁻¹ (Q − Φ_qᵀ λ). After each step the state is projected onto Φ 
 in the kinetic-energy metric M (the projection method of Hairer, Lubich & Wanner,
 Geometric Numerical Integration, §IV.4), which keeps ‖Φ‖ at round-off level.
 
-The state vector is y = [q, q̇, W], W the integrated powers (WORK_* below).
+The state vector is y = [q, q̇, W, z], W the integrated powers (WORK_* below), z the states of the force elements
+that have some (hydraulic cylinders: assembly/hydraulics.py); z is integrated and error-controlled like q and q̇ but
+not projected (it is bound by no constraint).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from clearsim.assembly.constraints import (
 from clearsim.assembly.forces import (
     STICK, add_applied_forces, add_clearance_forces, add_global_force, clearance_kinematics, stick_row,
 )
+from clearsim.assembly.hydraulics import add_hydraulic_forces, hydraulic_rates
 from clearsim.assembly.kinematics import point_position
 from clearsim.assembly.arrays import CL_BEARING_POINT, copy_into
 
@@ -30,7 +33,11 @@ WORK_CONTACT = 1
 WORK_FRICTION = 2
 WORK_DAMPING = 3
 WORK_APPLIED = 4
-WORK_COUNT = 5
+WORK_SUPPLY = 5  # energy the hydraulic supplies delivered, ∫ p_s Q_s dt
+WORK_TANK = 6  # energy the oil carried into the tanks, ∫ p_T Q_T dt
+WORK_ORIFICE = 7  # dissipated in the orifices, ∫ Σ Q Δp dt
+WORK_OIL = 8  # stored in the oil's compression, ∫ Σ p (Q_in − V̇) dt
+WORK_COUNT = 9
 
 # factor_key[0]: what the scratch holds (factored_jacobian)
 FACTOR_NONE, FACTOR_SPD, FACTOR_SINGULAR = 0, 1, 2
@@ -240,10 +247,12 @@ def generalized_forces(system, t, q, qd, modes, impact_speeds):
 
 
 @njit(cache=True)
-def forces_and_accelerations(system, t, q, qd, modes, impact_speeds):
-    """(q̈, λ, applied power, damping loss, contact loss, friction loss) at (t, q, q̇): the model's dynamics, which
-    the loop's kernels call by address (their `dynamics` argument), so it is compiled once, not into each of them."""
+def forces_and_accelerations(system, t, q, qd, z, modes, impact_speeds):
+    """(q̈, λ, applied power, damping loss, contact loss, friction loss) at (t, q, q̇) and element states z: the model's
+    dynamics, which the loop's kernels call by address (their `dynamics` argument), so it is compiled once, not into
+    each of them."""
     generalized, applied, damping, contact, friction = generalized_forces(system, t, q, qd, modes, impact_speeds)
+    add_hydraulic_forces(system, q, z, generalized)
     qdd, lam = accelerations(system, t, q, qd, generalized, modes)
     return qdd, lam, applied, damping, contact, friction
 
@@ -252,7 +261,13 @@ def dynamics_type(system_type):
     """The numba type of a `dynamics` argument: forces_and_accelerations called by its address."""
     vector, integers = types.float64[::1], types.int64[::1]
     result = types.Tuple((vector, vector, types.float64, types.float64, types.float64, types.float64))
-    return types.FunctionType(result(system_type, types.float64, vector, vector, integers, vector))
+    return types.FunctionType(result(system_type, types.float64, vector, vector, vector, integers, vector))
+
+
+@njit(cache=True, inline="always")
+def element_states(system, y):
+    """z: the force elements' states at the end of y."""
+    return y[2 * coordinate_count(system) + WORK_COUNT:]
 
 
 @njit(cache=True)
@@ -261,7 +276,8 @@ def rhs(system, dynamics, t, y, modes, impact_speeds, ydot):
     n = coordinate_count(system)
     q = y[:n]
     qd = y[n:2 * n]
-    qdd, lam, applied, damping, contact, friction = dynamics(system, t, q, qd, modes, impact_speeds)
+    z = element_states(system, y)
+    qdd, lam, applied, damping, contact, friction = dynamics(system, t, q, qd, z, modes, impact_speeds)
     copy_into(ydot[:n], qd)
     copy_into(ydot[n:2 * n], qdd)
     ydot[2 * n + WORK_DRIVER] = driver_power(system, t, lam)
@@ -269,6 +285,11 @@ def rhs(system, dynamics, t, y, modes, impact_speeds, ydot):
     ydot[2 * n + WORK_FRICTION] = friction
     ydot[2 * n + WORK_DAMPING] = damping
     ydot[2 * n + WORK_APPLIED] = applied
+    supply, tank, orifice, oil = hydraulic_rates(system, t, q, qd, z, element_states(system, ydot))
+    ydot[2 * n + WORK_SUPPLY] = supply
+    ydot[2 * n + WORK_TANK] = tank
+    ydot[2 * n + WORK_ORIFICE] = orifice
+    ydot[2 * n + WORK_OIL] = oil
 
 
 @njit(cache=True)

@@ -23,7 +23,7 @@ from clearsim.assembly.arrays import (
 )
 from clearsim.assembly.kinematics import (
     GROUND, add_point_force, body_frame, body_pose, body_rates, frame_point, frame_rotate, frame_velocity,
-    point_position, point_velocity,
+    line_kinematics, point_position, point_velocity,
 )
 from clearsim.assembly.constraints import prescribed
 from clearsim.physics.contact import damped_force
@@ -228,16 +228,8 @@ def add_applied_forces(system, t, q, qd, generalized):
 def spring_state(system, k, q, qd):
     """(tension f = k(ℓ − ℓ0) + c ℓ̇ + preload, ℓ̇, u_x, u_y) of spring-damper k, u from point i to j."""
     p = system.spring_params[k]
-    bi, bj = system.spring_bodies[k, 0], system.spring_bodies[k, 1]
-    frame_i = body_frame(q, bi)
-    frame_j = body_frame(q, bj)
-    xi, yi = frame_point(frame_i, p[0], p[1])
-    xj, yj = frame_point(frame_j, p[2], p[3])
-    vix, viy = frame_velocity(frame_i, qd, bi, p[0], p[1])
-    vjx, vjy = frame_velocity(frame_j, qd, bj, p[2], p[3])
-    length = max(np.sqrt((xj - xi) ** 2 + (yj - yi) ** 2), 1e-300)
-    ux, uy = (xj - xi) / length, (yj - yi) / length
-    rate = ux * (vjx - vix) + uy * (vjy - viy)
+    length, rate, ux, uy = line_kinematics(q, qd, system.spring_bodies[k, 0], system.spring_bodies[k, 1], p[0], p[1],
+                                           p[2], p[3])
     return p[4] * (length - p[6]) + p[5] * rate + p[7], rate, ux, uy
 
 

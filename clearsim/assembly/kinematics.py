@@ -82,3 +82,17 @@ def add_point_force(generalized, q, body, sx, sy, fx, fy):
     generalized[3 * body] += fx
     generalized[3 * body + 1] += fy
     generalized[3 * body + 2] += ax * fy - ay * fx
+
+
+@njit(cache=True)
+def line_kinematics(q, qd, bi, bj, sxi, syi, sxj, syj):
+    """(ℓ, ℓ̇, u_x, u_y) of the line from point i of body bi to point j of body bj, u its unit vector."""
+    frame_i = body_frame(q, bi)
+    frame_j = body_frame(q, bj)
+    xi, yi = frame_point(frame_i, sxi, syi)
+    xj, yj = frame_point(frame_j, sxj, syj)
+    vix, viy = frame_velocity(frame_i, qd, bi, sxi, syi)
+    vjx, vjy = frame_velocity(frame_j, qd, bj, sxj, syj)
+    length = max(np.sqrt((xj - xi) ** 2 + (yj - yi) ** 2), 1e-300)
+    ux, uy = (xj - xi) / length, (yj - yi) / length
+    return length, ux * (vjx - vix) + uy * (vjy - viy), ux, uy

@@ -8,12 +8,12 @@ again with the journals moving with their bearings.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from clearsim.assembly import build
+from clearsim.assembly import build, hydraulics
 from clearsim.assembly.arrays import KernelArrays, SystemArrays, for_kernels, mass_diagonal
 from clearsim.assembly.build import BuildError, ConstraintRows, Laws, Poses
 from clearsim.assembly.constraints import constraint_count, dense_jacobian, evaluate_constraints, evaluate_velocity_rhs
@@ -54,6 +54,8 @@ class System:
     qd0: np.ndarray
     degrees_of_freedom: int
     mechanism: schema.Mechanism
+    hydraulic_cylinders: list[str] = field(default_factory=list)  # in the order of their states in z
+    z0: np.ndarray = field(default_factory=lambda: np.zeros(0))  # the force elements' states at t = 0 (scaled)
 
     @property
     def coordinate_count(self) -> int:
@@ -64,7 +66,7 @@ def _loads(mechanism, poses: Poses, laws: Laws, base_dir: Path) -> list:
     loads = []
     for index, force in enumerate(mechanism.forces):
         path = ("forces", index)
-        if isinstance(force, schema.SpringDamper):
+        if isinstance(force, schema.TWO_ENDED):
             continue
         body = poses.index[force.body]
         point = poses.to_body_frame(body, poses.point_global(force.point, body, path + ("point",)))
@@ -81,25 +83,46 @@ def _loads(mechanism, poses: Poses, laws: Laws, base_dir: Path) -> list:
     return loads
 
 
+def _ends(poses: Poses, force, path) -> tuple[int, int, np.ndarray, np.ndarray, float]:
+    """(body i, body j, point i and point j in their body frames, length between them at t = 0) of a two-ended
+    force (`bodies:` with `at:` or `points:`)."""
+    if force.points is not None:
+        si, bi = poses.named_body_point(force.bodies[0], force.points[0], path + ("points", 0))
+        sj, bj = poses.named_body_point(force.bodies[1], force.points[1], path + ("points", 1))
+        pi, pj = poses.to_global(bi, si), poses.to_global(bj, sj)
+    else:
+        bi, bj = poses.index[force.bodies[0]], poses.index[force.bodies[1]]
+        ends = force.at if force.at is not None else (None, None)
+        pi = poses.point_global(ends[0], bi, path + ("at", 0))
+        pj = poses.point_global(ends[1], bj, path + ("at", 1))
+        si, sj = poses.to_body_frame(bi, pi), poses.to_body_frame(bj, pj)
+    return bi, bj, si, sj, float(np.linalg.norm(pj - pi))
+
+
 def _springs(mechanism, poses: Poses) -> list:
     springs = []
     for index, force in enumerate(mechanism.forces):
         if not isinstance(force, schema.SpringDamper):
             continue
-        path = ("forces", index)
-        if force.points is not None:
-            si, bi = poses.named_body_point(force.bodies[0], force.points[0], path + ("points", 0))
-            sj, bj = poses.named_body_point(force.bodies[1], force.points[1], path + ("points", 1))
-            pi, pj = poses.to_global(bi, si), poses.to_global(bj, sj)
-        else:
-            bi, bj = poses.index[force.bodies[0]], poses.index[force.bodies[1]]
-            ends = force.at if force.at is not None else (None, None)
-            pi = poses.point_global(ends[0], bi, path + ("at", 0))
-            pj = poses.point_global(ends[1], bj, path + ("at", 1))
-            si, sj = poses.to_body_frame(bi, pi), poses.to_body_frame(bj, pj)
-        free = force.free_length if force.free_length is not None else float(np.linalg.norm(pj - pi))
+        bi, bj, si, sj, length = _ends(poses, force, ("forces", index))
+        free = force.free_length if force.free_length is not None else length
         springs.append(((bi, bj), [*si, *sj, force.stiffness, force.damping, free, force.preload]))
     return springs
+
+
+def _cylinders(mechanism, poses: Poses, laws: Laws) -> list:
+    """(name, (body i, body j), params row, laws row, initial states) of each hydraulic cylinder."""
+    cylinders = []
+    for index, force in enumerate(mechanism.forces):
+        if not isinstance(force, schema.HydraulicCylinder):
+            continue
+        path = ("forces", index)
+        bi, bj, si, sj, length = _ends(poses, force, path)
+        problems = hydraulics.build_problems(force, length, mechanism.solver.t_end, path)
+        if problems:
+            raise BuildError(problems)
+        cylinders.append((force.name, (bi, bj), *hydraulics.cylinder_row(force, si, sj, length, laws.add)))
+    return cylinders
 
 
 def _sensors(mechanism, poses: Poses) -> list[SensorSpec]:
@@ -191,7 +214,7 @@ def _check_connected(mechanism, poses: Poses) -> None:
     """Every body reaches the ground through joints, springs or drivers."""
     neighbours = {name: set() for name in poses.index}
     links = [j.bodies for j in mechanism.joints]
-    links += [f.bodies for f in mechanism.forces if isinstance(f, schema.SpringDamper)]
+    links += [f.bodies for f in mechanism.forces if isinstance(f, schema.TWO_ENDED)]
     links += [(build.GROUND_NAME, d.body) for d in mechanism.drivers if d.body is not None]
     for a, b in links:
         neighbours[a].add(b)
@@ -219,7 +242,8 @@ def assemble(mechanism: schema.Mechanism, base_dir: Path | str = ".") -> System:
     for index, driver in enumerate(mechanism.drivers):
         build.add_driver(rows, laws, mechanism, poses, driver, base_dir, ("drivers", index))
     loads = _loads(mechanism, poses, laws, base_dir)
-    arrays = build.pack(mechanism, rows, clearances, laws, loads, _springs(mechanism, poses))
+    cylinders = _cylinders(mechanism, poses, laws)
+    arrays = build.pack(mechanism, rows, clearances, laws, loads, _springs(mechanism, poses), cylinders)
     owners = rows.row_owners()
     assembly_arrays = _pinned_clearances(arrays, clearances)
     assembly_owners = owners[: 2 * len(rows.pins)] + [c[-1] for c in clearances for _ in range(2)] + owners[2 * len(rows.pins):]
@@ -245,6 +269,8 @@ def assemble(mechanism: schema.Mechanism, base_dir: Path | str = ".") -> System:
         qd0=qd0,
         degrees_of_freedom=3 * len(mechanism.bodies) - rank,
         mechanism=mechanism,
+        hydraulic_cylinders=[c[0] for c in cylinders],
+        z0=np.array([z for c in cylinders for z in c[4]], float),
     )
 
 

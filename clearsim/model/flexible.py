@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from clearsim.errors import ClearsimError, Problem
-from clearsim.model.schema import PrismaticJoint, SpringDamper, validate_mechanism
+from clearsim.model.schema import TWO_ENDED, PrismaticJoint, validate_mechanism
 from clearsim.units import si_text
 
 
@@ -103,7 +103,7 @@ def _joint_location(mechanism, poses, joint, body: str) -> np.ndarray:
 def _force_ends(poses, force, body: str) -> list[tuple[int, np.ndarray]]:
     """(end index, global location at t = 0) of each end of a force that acts on `body`."""
     index = poses.index[body]
-    if not isinstance(force, SpringDamper):
+    if not isinstance(force, TWO_ENDED):
         return [(0, poses.point_global(force.point, index, ()))] if force.body == body else []
     ends = []
     for end, name in enumerate(force.bodies):
@@ -211,6 +211,7 @@ def initial_tensions(document: dict, splits: list[LinkSplit], base_dir) -> list[
     from clearsim.assembly.arrays import for_kernels
     from clearsim.assembly.build import BuildError
     from clearsim.assembly.dynamics import accelerations, generalized_forces
+    from clearsim.assembly.hydraulics import add_hydraulic_forces
     from clearsim.assembly.system import assemble
 
     locked = copy.deepcopy(document)
@@ -227,6 +228,7 @@ def initial_tensions(document: dict, splits: list[LinkSplit], base_dir) -> list[
     free = np.zeros(len(system.clearance_joints), np.int64)  # every journal starts in free flight (mode FREE)
     kernel_arrays = for_kernels(system.arrays)
     forces = generalized_forces(kernel_arrays, 0.0, system.q0, system.qd0, free, np.zeros(free.size))[0]
+    add_hydraulic_forces(kernel_arrays, system.q0, system.z0, forces)
     multipliers = accelerations(kernel_arrays, 0.0, system.q0, system.qd0, forces, free)[1]
     return [float(multipliers[dict(system.drivers)[lock]]) for lock in locks]
 

@@ -234,15 +234,16 @@ def _doubly_driven(mechanism: schema.Mechanism) -> list[Problem]:
 
 
 def _check_force(names: _Names, force, path: tuple) -> list[Problem]:
-    if not isinstance(force, schema.SpringDamper):
+    if not isinstance(force, schema.TWO_ENDED):
         return names.body(force.body, path + ("body",), ground_allowed=False) + names.global_point(
             force.point, path + ("point",))
+    kind = "spring" if isinstance(force, schema.SpringDamper) else "hydraulic cylinder"
     problems = [p for k in (0, 1) for p in names.body(force.bodies[k], path + ("bodies", k))]
     if force.bodies[0] == force.bodies[1]:
-        problems.append(Problem(path + ("bodies",), f"a spring connects two different bodies; both are '{force.bodies[0]}'",
-                                "name the two bodies it connects"))
+        problems.append(Problem(path + ("bodies",), f"a {kind} connects two different bodies; both are "
+                                f"'{force.bodies[0]}'", "name the two bodies it connects"))
     if force.at is not None and force.points is not None:
-        return problems + [Problem(path + ("points",), "a spring's ends are given by `at:` or by `points:`, not both",
+        return problems + [Problem(path + ("points",), f"a {kind}'s ends are given by `at:` or by `points:`, not both",
                                    "remove one of them")]
     if force.points is not None:
         problems += [p for k in (0, 1) for p in names.body_point(force.bodies[k], force.points[k], path + ("points", k))]

@@ -31,6 +31,8 @@ from clearsim.units import (
     Length,
     Mass,
     Pressure,
+    Density,
+    Volume,
     Speed,
     SpringStiffness,
     Time,
@@ -352,7 +354,134 @@ class TabulatedForce(Strict):
     _units_alone = field_validator("time_unit", "value_unit")(unit_name)
 
 
-AppliedForce = Annotated[Union[ConstantForce, SpringDamper, TabulatedForce], Field(discriminator="type")]
+# --- hydraulic cylinder (docs/model-drives.md "Hydraulic cylinder") --------------------------------
+
+
+class Accumulator(Strict):
+    """A gas-loaded accumulator: p V_g^n = p_0 V_0^n, the gas volume growing by the oil drawn."""
+
+    type: Literal["accumulator"] = Field(description="supply kind")
+    pressure: Pressure = Field(gt=0.0, description="gas pressure p_0 at t = 0 (the charged accumulator)")
+    gas_volume: Volume = Field(gt=0.0, description="gas volume V_0 at t = 0")
+    polytropic_index: float = Field(1.4, ge=1.0, le=1.67, description="polytropic index n (1 isothermal, 1.4 adiabatic nitrogen)")
+
+
+class ConstantSupply(Strict):
+    """A source that holds its pressure whatever flow it delivers."""
+
+    type: Literal["constant"] = Field(description="supply kind")
+    pressure: Pressure = Field(gt=0.0, description="supply pressure p_s")
+
+
+Supply = Annotated[Union[Accumulator, ConstantSupply], Field(discriminator="type")]
+
+
+class LinearValve(Strict):
+    """Opening a_v/a_max: 0 until `delay`, rising linearly to 1 over `opening_time`, then 1."""
+
+    law: Literal["linear"] = Field(description="valve law")
+    delay: Time = Field(0.0, ge=0.0, description="time t_d at which the valve starts to open")
+    opening_time: Time = Field(gt=0.0, description="time t_o from closed to fully open")
+
+
+def _increasing_abscissae(points: list, what: str) -> list:
+    if any(b[0] <= a[0] for a, b in zip(points, points[1:])):
+        raise ValueError(f"the {what} table's first column must increase from one point to the next")
+    return points
+
+
+class TableValve(Strict):
+    """Opening a_v/a_max linear between the listed [t, fraction] points, held before the first and after the last."""
+
+    law: Literal["table"] = Field(description="valve law")
+    points: list[tuple[Time, Annotated[float, Field(ge=0.0, le=1.0)]]] = Field(
+        min_length=2, description="[time, opening fraction 0..1] pairs, times increasing")
+
+    @field_validator("points")
+    @classmethod
+    def _increasing_and_opening(cls, points):
+        _increasing_abscissae(points, "valve")
+        if max(fraction for _, fraction in points) <= 0.0:
+            raise ValueError("the valve table never opens (every fraction is 0): the cylinder would never move; "
+                             "give the opening fraction it reaches (up to 1)")
+        return points
+
+
+ValveLaw = Annotated[Union[LinearValve, TableValve], Field(discriminator="law")]
+
+
+class LinearCushion(Strict):
+    """End-of-stroke cushion: the rod chamber's port area falls linearly from 1 to `residual_fraction` of itself
+    over the last `length` of the stroke (the rod chamber empties as the cylinder extends)."""
+
+    law: Literal["linear"] = Field(description="cushion law")
+    length: Length = Field(gt=0.0, description="stroke length L_c over which the cushion closes, before the stroke's end")
+    residual_fraction: float = Field(gt=0.0, le=1.0, description="port area left at the stroke's end, as a fraction of the open area")
+
+
+class TableCushion(Strict):
+    """The rod chamber's open port fraction linear between the listed [stroke, fraction] points, held outside them."""
+
+    law: Literal["table"] = Field(description="cushion law")
+    points: list[tuple[Length, Annotated[float, Field(ge=0.0, le=1.0)]]] = Field(
+        min_length=2, description="[stroke s, open fraction 0..1] pairs, strokes increasing")
+
+    _increasing = field_validator("points")(lambda points: _increasing_abscissae(points, "cushion"))
+
+
+CushionLaw = Annotated[Union[LinearCushion, TableCushion], Field(discriminator="law")]
+
+
+class ChamberPorts(Strict):
+    piston: Literal["valve", "supply", "tank"] = Field("valve", description="what the piston chamber A connects to")
+    rod: Literal["valve", "supply", "tank"] = Field("tank", description="what the rod chamber B connects to")
+
+
+class PortAreas(Strict):
+    piston: Area = Field(gt=0.0, description="orifice area of the piston chamber's port (fully open)")
+    rod: Area = Field(gt=0.0, description="orifice area of the rod chamber's port")
+
+
+class HydraulicCylinder(Strict):
+    """A double-acting cylinder between two bodies, pushing them apart with F = p_A A_A − p_B A_B along the line
+    between its two points; its pressures (and the accumulator's gas volume) are states integrated with the bodies.
+    A port `valve` goes to the supply through a_max·u(t) and to the tank through a_max·(1 − u(t)) (a 3/2-way valve,
+    u the valve law); `supply` and `tank` are permanent connections."""
+
+    type: Literal["hydraulic_cylinder"] = Field(description="force kind")
+    name: str = Field(description="unique force name (the result path /drives/<name>)")
+    bodies: tuple[str, str] = Field(description="[barrel end, rod end]: the two bodies (`ground` allowed)")
+    at: tuple[PointRef, PointRef] | None = Field(None, description="the two ends as global points at t = 0; default the centres of mass")
+    points: tuple[str, str] | None = Field(None, description="the two ends as named body points")
+    stroke: Length = Field(gt=0.0, description="full stroke S: the rod chamber's volume is V_B0 + A_B (S − s)")
+    initial_length: Length | None = Field(None, gt=0.0, description="length ℓ0 at which the stroke s = ℓ − ℓ0 is 0; default the length at t = 0")
+    piston_area: Area = Field(gt=0.0, description="piston area A_A (piston chamber)")
+    rod_side_area: Area = Field(gt=0.0, description="annulus area A_B (rod chamber)")
+    dead_volumes: tuple[Volume, Volume] = Field(description="[V_A0, V_B0]: oil volume of each chamber at s = 0 and s = S respectively (lines included)")
+    bulk_modulus: Pressure = Field(1.4e9, gt=0.0, description="oil bulk modulus β")
+    density: Density = Field(850.0, gt=0.0, description="oil density ρ")
+    discharge_coefficient: float = Field(0.7, gt=0.0, le=1.0, description="orifice discharge coefficient C_d")
+    transition_pressure: Pressure = Field(2e5, gt=0.0, description="p_tr: below this |Δp| the orifice flow is linear in Δp (laminar)")
+    supply: Supply = Field(description="the pressure source: an accumulator or a constant pressure")
+    tank_pressure: Pressure = Field(0.0, ge=0.0, description="return (tank) pressure p_T")
+    ports: ChamberPorts = Field(default_factory=ChamberPorts, description="what each chamber connects to")
+    port_areas: PortAreas = Field(description="fully open orifice area of each chamber's port")
+    valve: ValveLaw | None = Field(None, description="opening of the valve a_v(t)/a_max; needed when a port is `valve`")
+    cushion: CushionLaw | None = Field(None, description="end-of-stroke cushion on the rod chamber's port; absent: none")
+    initial_pressures: tuple[Pressure, Pressure] | None = Field(
+        None, description="[p_A, p_B] at t = 0; default: each chamber at the pressure its port connects it to at t = 0")
+    resisting_force: Force = Field(0.0, ge=0.0, description="the load's force against the extension at t = 0 (a spring's preload): checked against the supply")
+
+    @model_validator(mode="after")
+    def _valve_where_a_port_needs_it(self):
+        if self.valve is None and "valve" in (self.ports.piston, self.ports.rod):
+            raise ValueError("a port connects through the valve (`ports: … valve`) but the cylinder has no `valve:` "
+                             "law: give one, e.g. `valve: {law: linear, delay: 0 ms, opening_time: 5 ms}`")
+        return self
+
+
+AppliedForce = Annotated[Union[ConstantForce, SpringDamper, TabulatedForce, HydraulicCylinder], Field(discriminator="type")]
+TWO_ENDED = (SpringDamper, HydraulicCylinder)  # the forces between two bodies' points (`bodies:`, `at:`/`points:`)
 
 
 # --- sensors --------------------------------------------------------------------------------------

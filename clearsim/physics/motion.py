@@ -60,6 +60,17 @@ def table_law(times: np.ndarray, values: np.ndarray, relative: bool = True) -> P
     return PiecewisePolynomial(np.array(breaks), np.array(pieces))
 
 
+def polyline_law(points) -> PiecewisePolynomial:
+    """The polyline through [(x, value), …] (x increasing), held at its end values outside them (a valve's opening
+    against time, a cushion's open fraction against the stroke)."""
+    xs = np.array([x for x, _ in points], dtype=float)
+    values = np.array([value for _, value in points], dtype=float)
+    slopes = np.diff(values) / np.diff(xs)
+    pieces = [_pad([values[0]])] + [_pad([value, slope]) for value, slope in zip(values[:-1], slopes)]
+    pieces.append(_pad([values[-1]]))
+    return PiecewisePolynomial(np.concatenate([[xs[0] - 1.0], xs]), np.array(pieces))
+
+
 def _spline(times: np.ndarray, values: np.ndarray):
     """The not-a-knot cubic spline; ValueError when its slopes or coefficients exceed floating-point numbers."""
     from scipy.interpolate import CubicSpline

@@ -38,8 +38,8 @@ from clearsim.assembly.arrays import (
     CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_STIFFNESS, copy_into,
 )
 from clearsim.assembly.dynamics import (
-    coordinate_count, dynamics_type, effective_mass, forces_and_accelerations, project_positions, project_velocities,
-    rhs, stick_row_index,
+    WORK_COUNT, coordinate_count, dynamics_type, effective_mass, element_states, forces_and_accelerations,
+    project_positions, project_velocities, rhs, stick_row_index,
 )
 from clearsim.assembly.forces import (
     CONTACT, FREE, SLIDE_BACK, STICK, clearance_kinematics, contact_force_magnitudes, exact_stick,
@@ -94,7 +94,7 @@ def friction_reserve(system, dynamics, t, y, modes, speeds, k):
     n = coordinate_count(system)
     q = y[:n]
     qd = y[n:2 * n]
-    friction = -dynamics(system, t, q, qd, modes, speeds)[1][stick_row_index(system, modes, k)]
+    friction = -dynamics(system, t, q, qd, element_states(system, y), modes, speeds)[1][stick_row_index(system, modes, k)]
     kin = clearance_kinematics(system, k, q, qd)
     normal = contact_force_magnitudes(system, k, kin[4], kin[5], kin[8], modes[k], speeds[k])[0]
     p = system.clearance_params[k]
@@ -525,7 +525,7 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
             h = (capacity - 2) * real[R_SAMPLE_DT]
         error = step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new)
         ints[I_RHS] += 6
-        norm = error_norm(error, y, y_new, 2 * n, real[R_RTOL], real[R_ATOL])
+        norm = error_norm(error, y, y_new, 2 * n, WORK_COUNT, real[R_RTOL], real[R_ATOL])
         if not np.isfinite(norm):
             norm = 1e10
         if norm > 1.0:

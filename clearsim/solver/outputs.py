@@ -19,7 +19,11 @@ import numpy as np
 
 from clearsim.assembly.arrays import CL_CLEARANCE, CL_EXPONENT, CL_MIN_IMPACT_SPEED, CL_STIFFNESS, OFF_DIRECTION
 from clearsim.assembly.forces import STICK
-from clearsim.assembly.dynamics import WORK_APPLIED, WORK_CONTACT, WORK_DAMPING, WORK_DRIVER, WORK_FRICTION
+from clearsim.assembly import hydraulics
+from clearsim.assembly.dynamics import (
+    WORK_APPLIED, WORK_CONTACT, WORK_COUNT, WORK_DAMPING, WORK_DRIVER, WORK_FRICTION, WORK_OIL, WORK_ORIFICE, WORK_SUPPLY,
+    WORK_TANK,
+)
 from clearsim.assembly.system import SensorSpec, System
 from clearsim.model import schema
 from clearsim.physics.cylindrical import POWER_LAW_CODES, max_penetrations
@@ -38,7 +42,7 @@ LOWEST_DEFAULT_RATE, HIGHEST_DEFAULT_RATE = 1e3, 1e5  # Hz
 
 # datasets a user needs to full precision (docs/model.md §8); every other floating-point history is stored as float32
 FULL_PRECISION_SUFFIXES = ("/q", "/eccentricity", "/penetration", "/normal_force", "/friction_force")
-FULL_PRECISION_GROUPS = ("sensors/", "energy/")
+FULL_PRECISION_GROUPS = ("sensors/", "energy/", "drives/")
 
 COORDINATE_UNITS = {"q": "m, m, rad", "qd": "m/s, m/s, rad/s", "qdd": "m/s^2, m/s^2, rad/s^2"}
 
@@ -197,9 +201,13 @@ def energy_histories(system: System, chunk, initial_energy: float) -> dict:
         "damping_dissipated": work[:, WORK_DAMPING], "driver_work": work[:, WORK_DRIVER],
         "applied_work": work[:, WORK_APPLIED],
     }
+    if system.hydraulic_cylinders:
+        named |= {"hydraulic_supply_work": work[:, WORK_SUPPLY], "hydraulic_tank_work": work[:, WORK_TANK],
+                  "orifice_dissipated": work[:, WORK_ORIFICE], "oil_compression": work[:, WORK_OIL]}
     named["balance_error"] = (chunk.kinetic + chunk.potential - initial_energy - work[:, WORK_DRIVER]
                               - work[:, WORK_APPLIED] + work[:, WORK_CONTACT] + work[:, WORK_FRICTION]
-                              + work[:, WORK_DAMPING])
+                              + work[:, WORK_DAMPING] - work[:, WORK_SUPPLY] + work[:, WORK_TANK]
+                              + work[:, WORK_ORIFICE] + work[:, WORK_OIL])
     return {f"energy/{key}": (value, "J") for key, value in named.items()}
 
 
@@ -275,6 +283,10 @@ def chunk_outputs(system: System, chunk, modes: np.ndarray, initial_energy: floa
     joints = ideal_joint_reactions(system, chunk) | clearance_histories(system, chunk, modes)
     out |= joints
     out |= energy_histories(system, chunk, initial_energy)
+    n = system.coordinate_count
+    out |= hydraulics.drive_histories(system.hydraulic_cylinders, system.arrays.hydraulic_bodies,
+                                      system.arrays.hydraulic_params, chunk.states[:, :n],
+                                      chunk.states[:, 2 * n + WORK_COUNT:])
     out["constraints/violation"] = (chunk.violation, "m")
     origins = sensor_origins(system)
     for spec in system.sensors:

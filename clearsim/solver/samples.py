@@ -10,7 +10,7 @@ from numba import njit
 from clearsim.assembly.arrays import copy_into
 from clearsim.assembly.constraints import constraint_count
 from clearsim.assembly.dynamics import (
-    constraint_violation, coordinate_count, stick_row_index,
+    constraint_violation, coordinate_count, element_states, stick_row_index,
 )
 from clearsim.assembly.forces import STICK, clearance_kinematics, contact_force_magnitudes, potential_energy
 
@@ -29,7 +29,7 @@ def derive_sample(system, dynamics, t, state, modes, speeds, qdd, lam, contact, 
     m = constraint_count(system)
     q = state[:n].copy()
     qd = state[n:2 * n].copy()
-    accelerations, multipliers = dynamics(system, t, q, qd, modes, speeds)[:2]
+    accelerations, multipliers = dynamics(system, t, q, qd, element_states(system, state).copy(), modes, speeds)[:2]
     copy_into(qdd, accelerations)
     copy_into(lam, multipliers[:m])
     for k in range(system.clearance_bodies.shape[0]):

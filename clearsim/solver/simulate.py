@@ -45,7 +45,7 @@ class Chunk:
     """Output samples of one stretch of the run, with everything derived from them."""
 
     times: np.ndarray
-    states: np.ndarray  # (S, 2n + WORK_COUNT): q, q̇, integrated powers
+    states: np.ndarray  # (S, 2n + WORK_COUNT + nz): q, q̇, integrated powers, force elements' states
     modes: np.ndarray  # (S, nc) FREE / CONTACT while the sample's step ran
     impact_speeds: np.ndarray  # (S, nc) δ̇⁻ of the current contact episode
     episodes: np.ndarray  # (S, nc) index into the episode log, −1 in free flight
@@ -90,15 +90,22 @@ class EpisodeLog:
     effective_mass: np.ndarray
 
 
+def error_controlled(system: System, y: np.ndarray) -> np.ndarray:
+    """The components of a state (or its rate) that the step's error control weighs: q, q̇ and the element states z,
+    not the integrated powers W between them (dopri.error_norm)."""
+    n = system.coordinate_count
+    return np.concatenate([y[:2 * n], y[2 * n + WORK_COUNT:]])
+
+
 def _initial_step(system: System, y: np.ndarray, f: np.ndarray) -> float:
     """0.01 ‖y‖/‖ẏ‖ in the tolerance-weighted norm (Hairer, Nørsett & Wanner II.4), within the limits."""
     settings = system.mechanism.solver
     if settings.initial_step is not None:
         return settings.initial_step
-    n = system.coordinate_count
-    scale = settings.atol + settings.rtol * np.abs(y[: 2 * n])
-    d0 = np.sqrt(np.mean((y[: 2 * n] / scale) ** 2))
-    d1 = np.sqrt(np.mean((f[: 2 * n] / scale) ** 2))
+    y, f = error_controlled(system, y), error_controlled(system, f)
+    scale = settings.atol + settings.rtol * np.abs(y)
+    d0 = np.sqrt(np.mean((y / scale) ** 2))
+    d1 = np.sqrt(np.mean((f / scale) ** 2))
     guess = 0.01 * d0 / d1 if d0 > 1e-5 and d1 > 1e-5 else 1e-6
     return float(np.clip(guess, settings.min_step, settings.max_step))
 
@@ -209,7 +216,7 @@ class Run:
         self.kernel_arrays = for_kernels(arrays)
         nc = len(system.clearance_joints)
         n = system.coordinate_count
-        self.y = np.concatenate([system.q0, system.qd0, np.zeros(WORK_COUNT)])
+        self.y = np.concatenate([system.q0, system.qd0, np.zeros(WORK_COUNT), system.z0])
         self.f = np.zeros_like(self.y)
         self.modes = np.zeros(nc, np.int64)
         self.speeds = np.zeros(nc)

@@ -53,7 +53,7 @@ def test_the_dynamics_called_by_address_are_the_forces_and_accelerations():
     modes = np.zeros(system.arrays.clearance_bodies.shape[0], dtype=np.int64)
     speeds = np.zeros(modes.size)
     qdd, lam, applied, damping, contact, friction = forces_and_accelerations(arrays, 0.0, system.q0, system.qd0,
-                                                                             modes, speeds)
+                                                                             system.z0, modes, speeds)
     generalized, *powers = generalized_forces(arrays, 0.0, system.q0, system.qd0, modes, speeds)
     expected_qdd, expected_lam = accelerations(arrays, 0.0, system.q0, system.qd0, generalized, modes)
     assert np.array_equal(qdd, expected_qdd) and np.array_equal(lam, expected_lam)

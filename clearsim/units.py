@@ -94,6 +94,9 @@ DIMENSIONS = {
     "pressure": Dimension("pressure (modulus)", "Pa", _dims(mass=1, length=-1, time=-2), "207 GPa"),
     "spring_stiffness": Dimension("spring stiffness", "N/m", _dims(mass=1, time=-2), "1e5 N/m"),
     "damping": Dimension("damping coefficient", "N*s/m", _dims(mass=1, time=-1), "50 N*s/m"),
+    "second_moment": Dimension("second moment of area", "m^4", _dims(length=4), "8.3e-9 m^4"),
+    "rotational_stiffness": Dimension("rotational stiffness", "N*m/rad", _dims(mass=1, length=2, time=-2), "1400 N*m/rad"),
+    "rotational_damping": Dimension("rotational damping", "N*m*s/rad", _dims(mass=1, length=2, time=-1), "0.5 N*m*s/rad"),
     "dimensionless": Dimension("dimensionless number", "1", (), "0.2"),
 }
 
@@ -110,6 +113,9 @@ DERIVED_UNITS = {  # the other kinds, built from the base ones unless the block 
     "pressure": "{force}/{length}^2",
     "spring_stiffness": "{force}/{length}",
     "damping": "{force}*{time}/{length}",
+    "second_moment": "{length}^4",
+    "rotational_stiffness": "{force}*{length}/{angle}",
+    "rotational_damping": "{force}*{length}*{time}/{angle}",
 }
 CONTACT_STIFFNESS_UNIT = "{force}/{length}^{exponent:g}"  # K of F = K δⁿ
 
@@ -409,4 +415,7 @@ Area = _quantity_type("area")
 Pressure = _quantity_type("pressure")
 SpringStiffness = _quantity_type("spring_stiffness")
 Damping = _quantity_type("damping")
+SecondMoment = _quantity_type("second_moment")
+RotationalStiffness = _quantity_type("rotational_stiffness")
+RotationalDamping = _quantity_type("rotational_damping")
 Number = _quantity_type("dimensionless")

@@ -53,6 +53,8 @@ OFF_VALUE = 6  # c0
 LOAD_COLUMNS = 5
 # columns of spring_params: point i (2), point j (2), stiffness, damping, free length, preload
 SPRING_COLUMNS = 8
+# columns of torsion_params (rotational springs): stiffness, damping, free angle, preload
+TORSION_COLUMNS = 4
 
 SystemArrays = namedtuple(
     "SystemArrays",
@@ -65,12 +67,13 @@ SystemArrays = namedtuple(
         "clearance_bodies", "clearance_laws", "clearance_params",
         "load_bodies", "load_params", "load_law",
         "spring_bodies", "spring_params",
+        "torsion_bodies", "torsion_params",
     ],
 )
 
 
 # --- the form the kernels take: one numba structref holding the arrays above -------------------------
-# A kernel called with the namedtuple receives 23 arrays (≈ 200 machine words) and takes and releases a
+# A kernel called with the namedtuple receives 25 arrays (≈ 200 machine words) and takes and releases a
 # reference to each at every call; with the structref it receives one pointer. Same fields, same attribute
 # syntax in the kernels, results bitwise identical; the compiled loop takes 40–50 % less time and compiles
 # faster (docs/performance.md).

@@ -14,7 +14,7 @@ import numpy as np
 from clearsim.assembly.arrays import (
     CLEARANCE_COLUMNS, CLEARANCE_LAW_COLUMNS, CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_EXPONENT,
     CL_JOURNAL_POINT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_RESTITUTION, CL_STIFFNESS,
-    CL_V_HIGH, CL_V_LOW, LOAD_COLUMNS, SPRING_COLUMNS, SystemArrays,
+    CL_V_HIGH, CL_V_LOW, LOAD_COLUMNS, SPRING_COLUMNS, TORSION_COLUMNS, SystemArrays,
 )
 from clearsim.errors import Problem
 from clearsim.model import schema
@@ -230,7 +230,8 @@ def _float_array(values, columns) -> np.ndarray:
     return np.array(values, dtype=np.float64).reshape((len(values), columns))
 
 
-def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: list, springs: list) -> SystemArrays:
+def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: list, springs: list,
+         torsions: list) -> SystemArrays:
     """The arrays the kernels read, from the named lists."""
     breaks, coefficients, first, count = motion.concatenate(laws.items)
     return SystemArrays(
@@ -256,4 +257,6 @@ def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: l
         load_law=_int_array([ld[2] for ld in loads]),
         spring_bodies=_int_array([s[0] for s in springs], 2),
         spring_params=_float_array([s[1] for s in springs], SPRING_COLUMNS),
+        torsion_bodies=_int_array([s[0] for s in torsions], 2),
+        torsion_params=_float_array([s[1] for s in torsions], TORSION_COLUMNS),
     )

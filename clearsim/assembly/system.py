@@ -64,7 +64,7 @@ def _loads(mechanism, poses: Poses, laws: Laws, base_dir: Path) -> list:
     loads = []
     for index, force in enumerate(mechanism.forces):
         path = ("forces", index)
-        if isinstance(force, schema.SpringDamper):
+        if isinstance(force, (schema.SpringDamper, schema.RotationalSpring)):
             continue
         body = poses.index[force.body]
         point = poses.to_body_frame(body, poses.point_global(force.point, body, path + ("point",)))
@@ -100,6 +100,17 @@ def _springs(mechanism, poses: Poses) -> list:
         free = force.free_length if force.free_length is not None else float(np.linalg.norm(pj - pi))
         springs.append(((bi, bj), [*si, *sj, force.stiffness, force.damping, free, force.preload]))
     return springs
+
+
+def _torsions(mechanism, poses: Poses) -> list:
+    """((i, j), [k, c, θ₀, preload]) of each rotational spring; θ₀ defaults to θ_j − θ_i at t = 0."""
+    torsions = []
+    for force in mechanism.forces:
+        if isinstance(force, schema.RotationalSpring):
+            bi, bj = poses.index[force.bodies[0]], poses.index[force.bodies[1]]
+            free = force.free_angle if force.free_angle is not None else poses.pose(bj)[1] - poses.pose(bi)[1]
+            torsions.append(((bi, bj), [force.stiffness, force.damping, free, force.preload]))
+    return torsions
 
 
 def _sensors(mechanism, poses: Poses) -> list[SensorSpec]:
@@ -191,7 +202,7 @@ def _check_connected(mechanism, poses: Poses) -> None:
     """Every body reaches the ground through joints, springs or drivers."""
     neighbours = {name: set() for name in poses.index}
     links = [j.bodies for j in mechanism.joints]
-    links += [f.bodies for f in mechanism.forces if isinstance(f, schema.SpringDamper)]
+    links += [f.bodies for f in mechanism.forces if isinstance(f, (schema.SpringDamper, schema.RotationalSpring))]
     links += [(build.GROUND_NAME, d.body) for d in mechanism.drivers if d.body is not None]
     for a, b in links:
         neighbours[a].add(b)
@@ -219,7 +230,8 @@ def assemble(mechanism: schema.Mechanism, base_dir: Path | str = ".") -> System:
     for index, driver in enumerate(mechanism.drivers):
         build.add_driver(rows, laws, mechanism, poses, driver, base_dir, ("drivers", index))
     loads = _loads(mechanism, poses, laws, base_dir)
-    arrays = build.pack(mechanism, rows, clearances, laws, loads, _springs(mechanism, poses))
+    arrays = build.pack(mechanism, rows, clearances, laws, loads, _springs(mechanism, poses),
+                        _torsions(mechanism, poses))
     owners = rows.row_owners()
     assembly_arrays = _pinned_clearances(arrays, clearances)
     assembly_owners = owners[: 2 * len(rows.pins)] + [c[-1] for c in clearances for _ in range(2)] + owners[2 * len(rows.pins):]

@@ -313,7 +313,8 @@ def validate(config: Optional[Path] = ConfigArgument, overrides: List[str] = Set
     mechanism = system.mechanism
     written = {key: loaded.document.get(key) or [] for key in ("bodies", "joints")}  # as in the file, not expanded
     flexible = flexible_link_names(loaded.document)
-    stretches = f", {len(flexible)} from flexible links: {', '.join(flexible)}" if flexible else ""
+    added = len(mechanism.bodies) - len(written["bodies"])  # each new body adds one freedom: a half or a segment
+    stretches = f", {added} from flexible links: {', '.join(flexible)}" if flexible else ""
     console.print(f"{loaded.path}: OK — {len(written['bodies'])} bodies, {len(written['joints'])} joints, "
                   f"{len(mechanism.drivers)} drivers, {system.degrees_of_freedom} degrees of freedom "
                   f"({2 * len(system.clearance_joints)} from clearance joints: "

@@ -263,8 +263,9 @@ def initial_tensions(document: dict, splits: list[LinkSplit], base_dir) -> list[
 
 def expanded_document(document: dict, mechanism, base_dir) -> dict:
     """A copy of the document with every axial link split, its spring carrying the rigid link's tension at t = 0,
-    and every beam link cut into segments, unstressed at t = 0 (flexible_problems found none; `base_dir`: where the
-    file's tables are)."""
+    and every beam link cut into segments, unstressed at t = 0; with beam links, every body starts with the velocity
+    of the rigid mechanism at t = 0, so that no segment starts bending (the velocity nearest to the file's that the
+    chain allows would) (flexible_problems found none; `base_dir`: where the file's tables are)."""
     revolute, _ = joint_lists(mechanism)
     flexible = [body for body in mechanism.bodies if isinstance(body.flexible, AxialFlexibility)]
     splits = [link_split(mechanism, body.name, revolute[body.name]) for body in flexible]
@@ -275,9 +276,12 @@ def expanded_document(document: dict, mechanism, base_dir) -> dict:
         split_link(expanded, split)
         set_spring(expanded, split, axial_stiffness(body.flexible, split.length), body.flexible.damping_ratio,
                    body.flexible.stiffness_damping)
-    for body in mechanism.bodies:
-        if isinstance(body.flexible, BeamFlexibility):
-            expand_beam(expanded, mechanism, body.name)
+    beams = [body.name for body in mechanism.bodies if isinstance(body.flexible, BeamFlexibility)]
+    if beams:
+        velocities = rigid_velocities(mechanism, base_dir)
+        set_velocities(expanded, velocities)
+        for body in beams:
+            expand_beam(expanded, mechanism, body, velocities[body])
     return expanded
 
 
@@ -472,12 +476,35 @@ def explicit_centres(document: dict, mechanism, poses, body: str) -> None:
             entry["point"] = centre
 
 
-def expand_beam(document: dict, mechanism, body: str) -> None:
-    """Replace a beam link (beam_problems found none) by its segments, hinges and rotational springs in `document`."""
+def rigid_velocities(mechanism, base_dir) -> dict[str, tuple[float, float, float]]:
+    """Each body's (v_x, v_y, ω) at t = 0 in the mechanism as given, its links rigid (made consistent by assembly);
+    the file's velocities when that model cannot be assembled."""
+    from clearsim.assembly.build import BuildError
+    from clearsim.assembly.system import assemble
+
+    try:
+        system = assemble(mechanism, base_dir)
+    except (BuildError, ClearsimError, ValueError):
+        return {b.name: (*b.velocity, b.angular_velocity) for b in mechanism.bodies}
+    return {name: tuple(float(v) for v in system.qd0[3 * k:3 * k + 3]) for k, name in enumerate(system.body_names)}
+
+
+def set_velocities(document: dict, velocities: dict[str, tuple[float, float, float]]) -> None:
+    """The bodies of `document` named in `velocities` start with those (v_x, v_y, ω)."""
+    for entry in document["bodies"]:
+        if entry["name"] in velocities:
+            vx, vy, rate = velocities[entry["name"]]
+            entry["velocity"] = [si_text(vx, "speed"), si_text(vy, "speed")]
+            entry["angular_velocity"] = si_text(rate, "angular_speed")
+
+
+def expand_beam(document: dict, mechanism, body: str, velocity: tuple[float, float, float]) -> None:
+    """Replace a beam link (beam_problems found none) by its segments, hinges and rotational springs in `document`;
+    they start straight, moving as the rigid link with `velocity` (v_x, v_y, ω)."""
     from clearsim.assembly.build import initial_poses
 
     poses = initial_poses(mechanism)
-    source = mechanism.body(body)
+    source = mechanism.body(body).model_copy(update={"velocity": velocity[:2], "angular_velocity": velocity[2]})
     segments = beam_segments(mechanism, poses, beam_layout(mechanism, poses, body))
     layout = segments.layout
     explicit_centres(document, mechanism, poses, body)

@@ -332,3 +332,37 @@ def test_the_slider_crank_with_a_beam_rod_tends_to_the_rigid_one_as_the_rod_stif
                   / rigid - 1) for second_moment in (1e-9, 1e-6)]
     assert errors[1] <= 5e-3
     assert errors[1] < errors[0]
+
+
+# --- the rotational spring on its own -----------------------------------------------------------------------------
+
+TORSION_PENDULUM = """
+name: torsion pendulum
+units: SI
+bodies:
+  - {name: bar, mass: 2.0, inertia: 0.01, position: [0.1, 0], velocity: [0, 0.1], angular_velocity: 1.0}
+joints:
+  - {name: pivot, type: revolute, bodies: [ground, bar], at: [0, 0]}
+forces:
+  - {type: rotational_spring, name: torsion, bodies: [ground, bar], stiffness: 3 N*m/rad, damping: DAMPING}
+sensors:
+  - {name: angle, type: body_angle, body: bar}
+solver: {t_end: 3.0, output_rate: 10 kHz, rtol: 1e-10, atol: 1e-12}
+"""
+PIVOT_INERTIA = 0.01 + 2.0 * 0.1 ** 2  # kg·m² about the pivot
+
+
+def test_a_rotational_spring_makes_a_torsion_pendulum_of_frequency_root_k_over_j(simulate):
+    """θ(t) = (ω₀/ω) sin ω t with ω = √(k / J_O) = 10 rad/s, and the energy ½ J_O θ̇² + ½ k θ² conserved."""
+    result = simulate(TORSION_PENDULUM.replace("DAMPING", "0"))
+    omega = np.sqrt(3.0 / PIVOT_INERTIA)
+    assert result["sensors/angle"] == pytest.approx(np.sin(omega * result["time"]) / omega, abs=1e-7)
+    energy = result["energy/kinetic"] + result["energy/potential"]
+    assert np.max(np.abs(energy - energy[0])) <= 1e-8 * energy[0]
+
+
+def test_a_rotational_dampers_dissipation_closes_the_energy_balance(simulate):
+    result = simulate(TORSION_PENDULUM.replace("DAMPING", "0.02 N*m*s/rad"))
+    given = 0.5 * PIVOT_INERTIA * 1.0 ** 2
+    assert result["energy/damping_dissipated"][-1] > 0.5 * given  # ζ = 0.033: e^(−2 ζ ω t) ≈ 0.13 left at 3 s
+    assert np.max(np.abs(result["energy/balance_error"])) <= 1e-8 * given

@@ -199,8 +199,10 @@ def _travel_rows(travel: dict) -> list[tuple[str, str]]:
 def _print_plausibility_warnings(loaded) -> None:
     """Values of the file that are valid but look like a misread unit (clearsim.model.plausibility)."""
     from clearsim.model.plausibility import plausibility_warnings, warning_text
+    from clearsim.model.schema import validate_mechanism
 
-    for problem in plausibility_warnings(loaded.mechanism):
+    # the mechanism as written: a flexible link's expansion would be judged by its parts, at shifted places
+    for problem in plausibility_warnings(validate_mechanism(loaded.document)):
         errors.print(f"[bold yellow]warning:[/] {escape(warning_text([problem], loaded))}", markup=True,
                      highlight=False, soft_wrap=True)
 

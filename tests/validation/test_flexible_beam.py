@@ -366,3 +366,12 @@ def test_a_rotational_dampers_dissipation_closes_the_energy_balance(simulate):
     given = 0.5 * PIVOT_INERTIA * 1.0 ** 2
     assert result["energy/damping_dissipated"][-1] > 0.5 * given  # ζ = 0.033: e^(−2 ζ ω t) ≈ 0.13 left at 3 s
     assert np.max(np.abs(result["energy/balance_error"])) <= 1e-8 * given
+
+
+def test_the_plausibility_checks_judge_the_link_as_written_not_its_segments(tmp_path):
+    """The rod's end segment spans 6 mm between its joints; the 10 mm bearing is a fraction of the 120 mm rod."""
+    path = tmp_path / "flores_beam.yaml"
+    path.write_text(flores_with_flexible_rod(STEEL_ROD % (1e-9, "")))
+    result = CliRunner().invoke(app, ["validate", str(path)])
+    assert result.exit_code == 0
+    assert "warning" not in result.output

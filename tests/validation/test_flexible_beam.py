@@ -375,3 +375,15 @@ def test_the_plausibility_checks_judge_the_link_as_written_not_its_segments(tmp_
     result = CliRunner().invoke(app, ["validate", str(path)])
     assert result.exit_code == 0
     assert "warning" not in result.output
+
+
+def test_bare_section_and_rotational_values_are_read_in_the_files_units():
+    """`second_moment: mm^4` and `rotational_stiffness: N*mm/deg` in the units block: 1000 N·mm/deg = 57.3 N·m/rad;
+    a bare I of 1e3 mm⁴ is 1e-9 m⁴ (the steel rod's springs then carry E I n / L = 207·10/0.12 N·m/rad)."""
+    text = TORSION_PENDULUM.replace("units: SI", "units: {second_moment: mm^4, rotational_stiffness: N*mm/deg}")
+    text = text.replace("stiffness: 3 N*m/rad, damping: DAMPING", "stiffness: 1000")
+    assert load_mechanism_text(text).mechanism.forces[0].stiffness == pytest.approx(1000 * 1e-3 * 180 / np.pi, rel=1e-12)
+    rod = flores_with_flexible_rod("{model: beam, youngs_modulus: 207 GPa, second_moment_of_area: 1000}")
+    rod = rod.replace("name: Flores", "units: {second_moment: mm^4}\nname: Flores", 1)
+    springs = [f for f in load_mechanism_text(rod).mechanism.forces if f.name.startswith("rod_bend")]
+    assert len(springs) == 10 and springs[0].stiffness == pytest.approx(207 * 10 / 0.12, rel=1e-9)

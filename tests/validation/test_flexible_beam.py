@@ -387,3 +387,13 @@ def test_bare_section_and_rotational_values_are_read_in_the_files_units():
     rod = rod.replace("name: Flores", "units: {second_moment: mm^4}\nname: Flores", 1)
     springs = [f for f in load_mechanism_text(rod).mechanism.forces if f.name.startswith("rod_bend")]
     assert len(springs) == 10 and springs[0].stiffness == pytest.approx(207 * 10 / 0.12, rel=1e-9)
+
+
+def test_a_cantilever_turned_by_its_angle_has_the_same_modes():
+    """The same link along y (angle 90°, centre of mass at (0, L/2)): the segments are placed and turned by the body's
+    pose, so the modes are those along x."""
+    turned = (cantilever().replace(f"position: [{LENGTH / 2}, 0]", f"position: [0, {LENGTH / 2}]\n    angle: 90 deg")
+              .replace(f"axis: [[0, 0], [{LENGTH}, 0]]", f"axis: [[0, 0], [0, {LENGTH}]]")
+              .replace(f"point: [{LENGTH}, 0], direction: [0, 1]", f"point: [0, {LENGTH}], direction: [1, 0]"))
+    assert turned.count("[0, 1.0]") == 2 and "angle: 90 deg" in turned
+    assert linear_modes(turned)[:3] == pytest.approx(linear_modes(cantilever())[:3], rel=1e-6)

@@ -415,10 +415,6 @@ def beam_segments(mechanism, poses, layout: BeamLayout) -> BeamSegments | None:
     return BeamSegments(layout, names, masses, centre + np.outer(centres, layout.direction), inertias)
 
 
-def _attachment_place(attachment: Attachment) -> tuple:
-    return (attachment.section, attachment.index)
-
-
 def beam_problems(mechanism, index: int) -> list[Problem]:
     """What stops a beam link's expansion: no axis, an axis end or an attached point outside the link, an inertia no
     positive density along the axis gives, names taken."""
@@ -443,7 +439,7 @@ def beam_problems(mechanism, index: int) -> list[Problem]:
     for a in attached:
         along, across = layout.arc_length(a.location), layout.distance_from_axis(a.location)
         if not (-tolerance <= along <= layout.length + tolerance) or across > layout.length:
-            problems.append(Problem(_attachment_place(a), f"its point on beam link {body.name} lies outside the link: "
+            problems.append(Problem((a.section, a.index), f"its point on beam link {body.name} lies outside the link: "
                                     f"{along:.4g} m along its axis of length {layout.length:.4g} m, {across:.4g} m off "
                                     "it", f"attach it between the ends of {body.name}'s axis, or give {body.name} an "
                                     "`axis:` that spans it"))

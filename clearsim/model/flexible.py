@@ -26,7 +26,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from clearsim.errors import ClearsimError, Problem
-from clearsim.model.schema import AxialFlexibility, BeamFlexibility, PrismaticJoint, RotationalSpring, SpringDamper, validate_mechanism
+from clearsim.model.schema import (AxialFlexibility, BeamFlexibility, PrismaticJoint, RotationalSpring, SpringDamper,
+                                   validate_mechanism)
 from clearsim.units import si_text
 
 
@@ -389,14 +390,16 @@ class BeamSegments:
 
     def stiffness(self, flexibility) -> float:
         """k = E I / Δ (N·m/rad)."""
-        return flexibility.youngs_modulus * flexibility.second_moment_of_area * self.layout.elements / self.layout.length
+        bending = flexibility.youngs_modulus * flexibility.second_moment_of_area
+        return bending * self.layout.elements / self.layout.length
 
     def damping(self, flexibility) -> float:
         """c = β k, β = stiffness_damping + 2 ζ / ω₁ with ω₁ = (β₁L)² √(E I / (m L³)) the link's first cantilever
         bending mode (N·m·s/rad)."""
         bending = flexibility.youngs_modulus * flexibility.second_moment_of_area
         first_mode = FIRST_CANTILEVER_ROOT ** 2 * math.sqrt(bending / (self.masses.sum() * self.layout.length ** 3))
-        return (flexibility.stiffness_damping + 2.0 * flexibility.damping_ratio / first_mode) * self.stiffness(flexibility)
+        proportional = flexibility.stiffness_damping + 2.0 * flexibility.damping_ratio / first_mode
+        return proportional * self.stiffness(flexibility)
 
 
 def beam_segments(mechanism, poses, layout: BeamLayout) -> BeamSegments | None:
@@ -517,7 +520,8 @@ def expand_beam(document: dict, mechanism, body: str, velocity: tuple[float, flo
                       "position": point_text(centre), "angle": si_text(source.angle, "angle"),
                       "velocity": [si_text(v, "speed") for v in velocity],
                       "angular_velocity": si_text(source.angular_velocity, "angular_speed"),
-                      "points": {key: point_text(np.asarray(point, float) - local) for key, point in source.points.items()}})
+                      "points": {key: point_text(np.asarray(point, float) - local)
+                                 for key, point in source.points.items()}})
     position = next(i for i, b in enumerate(document["bodies"]) if b["name"] == body)
     document["bodies"][position:position + 1] = parts
     stiffness, damping = segments.stiffness(source.flexible), segments.damping(source.flexible)

@@ -199,8 +199,10 @@ def _travel_rows(travel: dict) -> list[tuple[str, str]]:
 def _print_plausibility_warnings(loaded) -> None:
     """Values of the file that are valid but look like a misread unit (clearsim.model.plausibility)."""
     from clearsim.model.plausibility import plausibility_warnings, warning_text
+    from clearsim.model.schema import validate_mechanism
 
-    for problem in plausibility_warnings(loaded.mechanism):
+    # the mechanism as written: a flexible link's expansion would be judged by its parts, at shifted places
+    for problem in plausibility_warnings(validate_mechanism(loaded.document)):
         errors.print(f"[bold yellow]warning:[/] {escape(warning_text([problem], loaded))}", markup=True,
                      highlight=False, soft_wrap=True)
 
@@ -313,7 +315,8 @@ def validate(config: Optional[Path] = ConfigArgument, overrides: List[str] = Set
     mechanism = system.mechanism
     written = {key: loaded.document.get(key) or [] for key in ("bodies", "joints")}  # as in the file, not expanded
     flexible = flexible_link_names(loaded.document)
-    stretches = f", {len(flexible)} from flexible links: {', '.join(flexible)}" if flexible else ""
+    added = len(mechanism.bodies) - len(written["bodies"])  # each new body adds one freedom: a half or a segment
+    stretches = f", {added} from flexible links: {', '.join(flexible)}" if flexible else ""
     console.print(f"{loaded.path}: OK — {len(written['bodies'])} bodies, {len(written['joints'])} joints, "
                   f"{len(mechanism.drivers)} drivers, {system.degrees_of_freedom} degrees of freedom "
                   f"({2 * len(system.clearance_joints)} from clearance joints: "

@@ -131,7 +131,7 @@ def _final_attributes(run: Run, warnings: list[str]) -> dict:
 def _mode_attributes(system: System, loaded: LoadedMechanism, run: Run, whirls: dict) -> dict:
     """`flexible_modes`: the flexible links' axial modes and what they are near (clearsim.model.modes), when the file
     has flexible links."""
-    links = flexible_link_names(loaded.document)
+    links = flexible_link_names(loaded.document, "axial")
     if not links:
         return {}
     return {"flexible_modes": flexible_modes_attribute(system, links, loaded.base_dir, run.episode_log(), whirls)}

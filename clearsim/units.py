@@ -97,6 +97,9 @@ DIMENSIONS = {
     "spring_stiffness": Dimension("spring stiffness", "N/m", _dims(mass=1, time=-2), "1e5 N/m"),
     "damping": Dimension("damping coefficient", "N*s/m", _dims(mass=1, time=-1), "50 N*s/m"),
     "viscosity": Dimension("dynamic viscosity", "Pa*s", _dims(mass=1, length=-1, time=-1), "0.1 Pa*s"),
+    "second_moment": Dimension("second moment of area", "m^4", _dims(length=4), "8.3e-9 m^4"),
+    "rotational_stiffness": Dimension("rotational stiffness", "N*m/rad", _dims(mass=1, length=2, time=-2), "1400 N*m/rad"),
+    "rotational_damping": Dimension("rotational damping", "N*m*s/rad", _dims(mass=1, length=2, time=-1), "0.5 N*m*s/rad"),
     "dimensionless": Dimension("dimensionless number", "1", (), "0.2"),
 }
 
@@ -116,6 +119,9 @@ DERIVED_UNITS = {  # the other kinds, built from the base ones unless the block 
     "spring_stiffness": "{force}/{length}",
     "damping": "{force}*{time}/{length}",
     "viscosity": "{force}*{time}/{length}^2",
+    "second_moment": "{length}^4",
+    "rotational_stiffness": "{force}*{length}/{angle}",
+    "rotational_damping": "{force}*{length}*{time}/{angle}",
 }
 CONTACT_STIFFNESS_UNIT = "{force}/{length}^{exponent:g}"  # K of F = K δⁿ
 
@@ -418,4 +424,7 @@ Density = _quantity_type("density")
 SpringStiffness = _quantity_type("spring_stiffness")
 Damping = _quantity_type("damping")
 Viscosity = _quantity_type("viscosity")
+SecondMoment = _quantity_type("second_moment")
+RotationalStiffness = _quantity_type("rotational_stiffness")
+RotationalDamping = _quantity_type("rotational_damping")
 Number = _quantity_type("dimensionless")

@@ -60,6 +60,8 @@ SPRING_COLUMNS = 8
 # columns of hydraulic_params and hydraulic_laws: clearsim/assembly/hydraulics.py HY_*, HL_*
 HYDRAULIC_COLUMNS = 20
 HYDRAULIC_LAW_COLUMNS = 4
+# columns of torsion_params (rotational springs): stiffness, damping, free angle, preload
+TORSION_COLUMNS = 4
 
 SystemArrays = namedtuple(
     "SystemArrays",
@@ -73,6 +75,7 @@ SystemArrays = namedtuple(
         "load_bodies", "load_params", "load_law",
         "spring_bodies", "spring_params",
         "hydraulic_bodies", "hydraulic_params", "hydraulic_laws",
+        "torsion_bodies", "torsion_params",
     ],
     # force elements with states (assembly/hydraulics.py): none unless given
     defaults=(np.zeros((0, 2), np.int64), np.zeros((0, HYDRAULIC_COLUMNS)), np.zeros((0, HYDRAULIC_LAW_COLUMNS), np.int64)),
@@ -80,7 +83,7 @@ SystemArrays = namedtuple(
 
 
 # --- the form the kernels take: one numba structref holding the arrays above -------------------------
-# A kernel called with the namedtuple receives 23 arrays (≈ 200 machine words) and takes and releases a
+# A kernel called with the namedtuple receives 25 arrays (≈ 200 machine words) and takes and releases a
 # reference to each at every call; with the structref it receives one pointer. Same fields, same attribute
 # syntax in the kernels, results bitwise identical; the compiled loop takes 40–50 % less time and compiles
 # faster (docs/performance.md).

@@ -15,7 +15,7 @@ from clearsim.assembly.arrays import (
     CLEARANCE_COLUMNS, CLEARANCE_LAW_COLUMNS, CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_DRY_GAP,
     CL_EXPONENT, CL_FILM_LENGTH, CL_JOURNAL_POINT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S,
     CL_RESTITUTION, CL_STIFFNESS, CL_V_HIGH, CL_V_LOW, CL_VISCOSITY, HYDRAULIC_COLUMNS, HYDRAULIC_LAW_COLUMNS,
-    LOAD_COLUMNS, SPRING_COLUMNS, SystemArrays,
+    LOAD_COLUMNS, SPRING_COLUMNS, TORSION_COLUMNS, SystemArrays,
 )
 from clearsim.errors import Problem
 from clearsim.model import schema
@@ -235,7 +235,7 @@ def _float_array(values, columns) -> np.ndarray:
 
 
 def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: list, springs: list,
-         cylinders: list = ()) -> SystemArrays:
+         torsions: list, cylinders: list = ()) -> SystemArrays:
     """The arrays the kernels read, from the named lists (cylinders: system._cylinders')."""
     breaks, coefficients, first, count = motion.concatenate(laws.items)
     return SystemArrays(
@@ -265,4 +265,6 @@ def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: l
         hydraulic_bodies=_int_array([c[1] for c in cylinders], 2),
         hydraulic_params=_float_array([c[2] for c in cylinders], HYDRAULIC_COLUMNS),
         hydraulic_laws=_int_array([c[3] for c in cylinders], HYDRAULIC_LAW_COLUMNS),
+        torsion_bodies=_int_array([s[0] for s in torsions], 2),
+        torsion_params=_float_array([s[1] for s in torsions], TORSION_COLUMNS),
     )

@@ -1,4 +1,5 @@
-"""Generalised forces Q(t, q, q̇): gravity, point loads, spring-dampers and clearance contacts (compiled).
+"""Generalised forces Q(t, q, q̇): gravity, point loads, spring-dampers, rotational springs and clearance contacts
+(compiled).
 
 Clearance joint k (Meng 2015 §2, restated in docs/model.md §3): bearing centre P_B on the first body,
 journal centre P_J on the second; eccentricity e = P_J − P_B, n = e/|e|, penetration δ = |e| − c,
@@ -198,7 +199,7 @@ def add_film_forces(system, k, q, qd, generalized):
 
 @njit(cache=True)
 def add_applied_forces(system, t, q, qd, generalized):
-    """Add gravity, point loads and spring-dampers; return (applied power, spring damping loss)."""
+    """Add gravity, point loads, spring-dampers and rotational springs; return (applied power, spring damping loss)."""
     for b in range(system.mass.shape[0]):
         generalized[3 * b] += system.mass[b] * system.gravity[0]
         generalized[3 * b + 1] += system.mass[b] * system.gravity[1]
@@ -221,7 +222,30 @@ def add_applied_forces(system, t, q, qd, generalized):
         add_point_force(generalized, q, bi, p[0], p[1], tension * ux, tension * uy)
         add_point_force(generalized, q, bj, p[2], p[3], -tension * ux, -tension * uy)
         damping_loss += p[5] * rate * rate
+    for k in range(system.torsion_bodies.shape[0]):
+        torque, rate = torsion_state(system, k, q, qd)
+        bi, bj = system.torsion_bodies[k, 0], system.torsion_bodies[k, 1]
+        if bi != GROUND:
+            generalized[3 * bi + 2] += torque
+        if bj != GROUND:
+            generalized[3 * bj + 2] -= torque
+        damping_loss += system.torsion_params[k, 1] * rate * rate
     return applied_power, damping_loss
+
+
+@njit(cache=True)
+def relative_angle(system, k, q):
+    """θ_j − θ_i of rotational spring k (a ground end's angle is 0)."""
+    return body_pose(q, system.torsion_bodies[k, 1])[2] - body_pose(q, system.torsion_bodies[k, 0])[2]
+
+
+@njit(cache=True)
+def torsion_state(system, k, q, qd):
+    """(torque T = k (θ_j − θ_i − θ₀) + c (ω_j − ω_i) + preload, ω_j − ω_i) of rotational spring k: −T acts on body
+    j, +T on body i."""
+    p = system.torsion_params[k]
+    rate = body_rates(qd, system.torsion_bodies[k, 1])[2] - body_rates(qd, system.torsion_bodies[k, 0])[2]
+    return p[0] * (relative_angle(system, k, q) - p[2]) + p[1] * rate + p[3], rate
 
 
 @njit(cache=True)
@@ -235,7 +259,8 @@ def spring_state(system, k, q, qd):
 
 @njit(cache=True)
 def potential_energy(system, q):
-    """Gravity + spring (elastic and preload) + contact elastic energy ∫₀^δ F_el (K δⁿ⁺¹/(n+1) for the power laws)."""
+    """Gravity + spring and rotational spring (elastic and preload) + contact elastic energy ∫₀^δ F_el
+    (K δⁿ⁺¹/(n+1) for the power laws)."""
     energy = 0.0
     for b in range(system.mass.shape[0]):
         energy -= system.mass[b] * (system.gravity[0] * q[3 * b] + system.gravity[1] * q[3 * b + 1])
@@ -246,6 +271,10 @@ def potential_energy(system, q):
         xj, yj = point_position(q, system.spring_bodies[k, 1], p[2], p[3])
         length = np.sqrt((xj - xi) ** 2 + (yj - yi) ** 2)
         energy += 0.5 * p[4] * (length - p[6]) ** 2 + p[7] * length
+    for k in range(system.torsion_bodies.shape[0]):
+        p = system.torsion_params[k]
+        angle = relative_angle(system, k, q)
+        energy += 0.5 * p[0] * (angle - p[2]) ** 2 + p[3] * angle
     for k in range(system.clearance_bodies.shape[0]):
         penetration = clearance_kinematics(system, k, q, zero)[4]
         p = system.clearance_params[k]

@@ -66,7 +66,7 @@ def _loads(mechanism, poses: Poses, laws: Laws, base_dir: Path) -> list:
     loads = []
     for index, force in enumerate(mechanism.forces):
         path = ("forces", index)
-        if isinstance(force, schema.TWO_ENDED):
+        if isinstance(force, schema.TWO_BODY):
             continue
         body = poses.index[force.body]
         point = poses.to_body_frame(body, poses.point_global(force.point, body, path + ("point",)))
@@ -123,6 +123,17 @@ def _cylinders(mechanism, poses: Poses, laws: Laws) -> list:
             raise BuildError(problems)
         cylinders.append((force.name, (bi, bj), *hydraulics.cylinder_row(force, si, sj, length, laws.add)))
     return cylinders
+
+
+def _torsions(mechanism, poses: Poses) -> list:
+    """((i, j), [k, c, θ₀, preload]) of each rotational spring; θ₀ defaults to θ_j − θ_i at t = 0."""
+    torsions = []
+    for force in mechanism.forces:
+        if isinstance(force, schema.RotationalSpring):
+            bi, bj = poses.index[force.bodies[0]], poses.index[force.bodies[1]]
+            free = force.free_angle if force.free_angle is not None else poses.pose(bj)[1] - poses.pose(bi)[1]
+            torsions.append(((bi, bj), [force.stiffness, force.damping, free, force.preload]))
+    return torsions
 
 
 def _sensors(mechanism, poses: Poses) -> list[SensorSpec]:
@@ -214,7 +225,7 @@ def _check_connected(mechanism, poses: Poses) -> None:
     """Every body reaches the ground through joints, springs or drivers."""
     neighbours = {name: set() for name in poses.index}
     links = [j.bodies for j in mechanism.joints]
-    links += [f.bodies for f in mechanism.forces if isinstance(f, schema.TWO_ENDED)]
+    links += [f.bodies for f in mechanism.forces if isinstance(f, schema.TWO_BODY)]
     links += [(build.GROUND_NAME, d.body) for d in mechanism.drivers if d.body is not None]
     for a, b in links:
         neighbours[a].add(b)
@@ -243,7 +254,8 @@ def assemble(mechanism: schema.Mechanism, base_dir: Path | str = ".") -> System:
         build.add_driver(rows, laws, mechanism, poses, driver, base_dir, ("drivers", index))
     loads = _loads(mechanism, poses, laws, base_dir)
     cylinders = _cylinders(mechanism, poses, laws)
-    arrays = build.pack(mechanism, rows, clearances, laws, loads, _springs(mechanism, poses), cylinders)
+    arrays = build.pack(mechanism, rows, clearances, laws, loads, _springs(mechanism, poses),
+                        _torsions(mechanism, poses), cylinders)
     owners = rows.row_owners()
     assembly_arrays = _pinned_clearances(arrays, clearances)
     assembly_owners = owners[: 2 * len(rows.pins)] + [c[-1] for c in clearances for _ in range(2)] + owners[2 * len(rows.pins):]

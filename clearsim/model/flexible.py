@@ -1,12 +1,20 @@
-"""Axially flexible links: a two-joint link as two halves sliding along the line between its joints.
+"""Flexible links, expanded into rigid bodies, joints and springs when the file is loaded (expanded_document).
 
+Axial (`model: axial`): a two-joint link as two halves sliding along the line between its joints.
 The half at the first joint (in file order) keeps the body's name; the other, `<body>_<joint>_half`, is new.
 Both start with the body's pose, centre of mass and body points, half its mass and half its inertia, so the
 pair has the link's mass, centre of mass and inertia. A prismatic joint `<body>_stretch` along the line
 between the joints keeps them aligned, and a spring-damper `<body>_compliance` between the two joint points
 is the link's axial stiffness k and damping c. Joints, sensors and loads at points nearer the second joint
-move to the new half. A body's `flexible:` block is expanded so when the file is loaded (expanded_document);
-diagnose's compliance candidate writes the same split into a document (split_link).
+move to the new half. diagnose's compliance candidate writes the same split into a document (split_link).
+
+Beam (`model: beam`, the rigid finite element method): the link's axis of length L cut into n equal elements
+of length Δ = L/n, a rigid segment from the middle of one element to the middle of the next (the two end
+segments Δ/2 long), pins `<body>_hinge<k>` and rotational springs `<body>_bend<k>` k = E I / Δ at the element
+middles. The segments' masses, centres of mass and inertias are the moments of one density along the axis,
+ρ(u) = a + b u + c u², fitted to the file's mass, centre of mass and inertia. Joints, sensors, loads and springs
+go to the segment holding their point's projection on the axis; the segment holding the first joint keeps the
+body's name, the others are `<body>_s<k>` (docs/model.md, "Flexible links: the beam element").
 """
 
 from __future__ import annotations
@@ -18,7 +26,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from clearsim.errors import ClearsimError, Problem
-from clearsim.model.schema import TWO_ENDED, PrismaticJoint, validate_mechanism
+from clearsim.model.schema import (TWO_ENDED, AxialFlexibility, BeamFlexibility, PrismaticJoint, RotationalSpring,
+                                   SpringDamper, validate_mechanism)
 from clearsim.units import si_text
 
 
@@ -30,9 +39,7 @@ class LinkSplit:
     half: str  # the new body, at the second joint
     near: tuple[float, float]  # global location of the first joint at t = 0
     far: tuple[float, float]  # of the second
-    moved_joint: str  # the second joint: its reference to the body goes to the new half
-    moved_sensors: frozenset  # point sensors nearer the second joint
-    moved_ends: dict  # force name → indices of its ends on the body nearer the second joint (single-body force: (0,))
+    moved: frozenset  # the attachments (Attachment.key) nearer the second joint: they go to the new half
     mass: float  # kg, of the whole link
     inertia: float  # kg·m², of the whole link
     tension: float = 0.0  # N: the axial tension the spring carries at t = 0 (free length L − T₀/k)
@@ -101,8 +108,11 @@ def _joint_location(mechanism, poses, joint, body: str) -> np.ndarray:
 
 
 def _force_ends(poses, force, body: str) -> list[tuple[int, np.ndarray]]:
-    """(end index, global location at t = 0) of each end of a force that acts on `body`."""
+    """(end index, global location at t = 0) of each end of a force that acts at a point of `body` (a rotational
+    spring acts at none: it stays on the body's named part)."""
     index = poses.index[body]
+    if isinstance(force, RotationalSpring):
+        return []
     if not isinstance(force, TWO_ENDED):
         return [(0, poses.point_global(force.point, index, ()))] if force.body == body else []
     ends = []
@@ -114,6 +124,42 @@ def _force_ends(poses, force, body: str) -> list[tuple[int, np.ndarray]]:
         else:
             ends.append((end, poses.point_global(force.at[end] if force.at is not None else None, index, ())))
     return ends
+
+
+@dataclass(frozen=True)
+class Attachment:
+    """One reference of the file to a body at a point: a joint's end, a point sensor, a force's end."""
+
+    section: str  # "joints", "sensors" or "forces"
+    index: int  # of the entry in its section
+    end: int  # of the body in the entry's `bodies` (0: an entry with `body:`)
+    location: np.ndarray  # global, at t = 0
+
+    @property
+    def key(self) -> tuple[str, int, int]:
+        return self.section, self.index, self.end
+
+
+def attachments(mechanism, poses, body: str) -> list[Attachment]:
+    """Every joint end, point sensor and force end on `body`, with where it acts at t = 0."""
+    found = [Attachment("joints", k, end, _joint_location(mechanism, poses, joint, body))
+             for k, joint in enumerate(mechanism.joints) for end, name in enumerate(joint.bodies) if name == body]
+    found += [Attachment("sensors", k, 0, poses.point_global(sensor.point, poses.index[body], ()))
+              for k, sensor in enumerate(mechanism.sensors)
+              if getattr(sensor, "body", None) == body and hasattr(sensor, "point")]
+    found += [Attachment("forces", k, end, where) for k, force in enumerate(mechanism.forces)
+              for end, where in _force_ends(poses, force, body)]
+    return found
+
+
+def retarget(document: dict, owners: dict[tuple[str, int, int], str]) -> None:
+    """Each attachment (by key) to the body `owners` names."""
+    for (section, index, end), owner in owners.items():
+        entry = document[section][index]
+        if "body" in entry:
+            entry["body"] = owner
+        else:
+            entry["bodies"] = [owner if k == end else name for k, name in enumerate(entry["bodies"])]
 
 
 def link_split(mechanism, body: str, joints: list) -> LinkSplit | None:
@@ -129,12 +175,9 @@ def link_split(mechanism, body: str, joints: list) -> LinkSplit | None:
     def nearer_far(point) -> bool:
         return float(np.dot(np.asarray(point, float) - near, axis)) > 0.5 * float(np.dot(axis, axis))
 
-    sensors = frozenset(s.name for s in mechanism.sensors if getattr(s, "body", None) == body and hasattr(s, "point")
-                        and nearer_far(poses.point_global(s.point, poses.index[body], ())))
-    moved = {f.name: tuple(end for end, where in _force_ends(poses, f, body) if nearer_far(where)) for f in mechanism.forces}
-    split = LinkSplit(body, f"{body}_{joints[1].name}_half", tuple(near.tolist()), tuple(far.tolist()), joints[1].name, sensors,
-                      {name: ends for name, ends in moved.items() if ends}, mechanism.body(body).mass,
-                      mechanism.body(body).inertia)
+    moved = frozenset(a.key for a in attachments(mechanism, poses, body) if nearer_far(a.location))
+    split = LinkSplit(body, f"{body}_{joints[1].name}_half", tuple(near.tolist()), tuple(far.tolist()), moved,
+                      mechanism.body(body).mass, mechanism.body(body).inertia)
     taken = {b.name for b in mechanism.bodies} | {j.name for j in mechanism.joints} | {f.name for f in mechanism.forces}
     return None if {split.half, split.guide, split.spring} & taken else split
 
@@ -148,22 +191,7 @@ def split_link(document: dict, split: LinkSplit) -> None:
     near["mass"] = si_text(split.mass / 2.0, "mass")
     near["inertia"] = si_text(split.inertia / 2.0, "inertia")
     bodies.insert(position + 1, {**copy.deepcopy(near), "name": split.half})
-
-    def moved(names, ends):
-        return [split.half if k in ends and n == split.body else n for k, n in enumerate(names)]
-
-    for joint in document["joints"]:
-        if joint["name"] == split.moved_joint:
-            joint["bodies"] = moved(joint["bodies"], (0, 1))
-    for sensor in document.get("sensors") or []:
-        if sensor["name"] in split.moved_sensors:
-            sensor["body"] = split.half
-    for force in document.get("forces") or []:
-        ends = split.moved_ends.get(force["name"], ())
-        if ends and "body" in force:
-            force["body"] = split.half
-        elif ends:
-            force["bodies"] = moved(force["bodies"], ends)
+    retarget(document, dict.fromkeys(split.moved, split.half))
     axis = np.subtract(split.far, split.near)
     document["joints"].append({"name": split.guide, "type": "prismatic", "bodies": [split.body, split.half],
                                "at": point_text(split.near), "axis": (axis / np.linalg.norm(axis)).tolist()})
@@ -177,18 +205,21 @@ def point_text(point) -> list[str]:
     return [si_text(coordinate, "length") for coordinate in point]
 
 
-def flexible_link_names(document: dict) -> list[str]:
-    """The bodies the file declares flexible, in file order."""
-    return [body["name"] for body in document.get("bodies") or [] if isinstance(body, dict) and body.get("flexible")]
+def flexible_link_names(document: dict, model: str | None = None) -> list[str]:
+    """The bodies the file declares flexible (of `model`, "axial" or "beam", when given), in file order."""
+    return [body["name"] for body in document.get("bodies") or [] if isinstance(body, dict) and body.get("flexible")
+            and (model is None or body["flexible"].get("model") == model)]
 
 
 def flexible_problems(mechanism) -> list[Problem]:
-    """Each flexible body that cannot be split: not exactly two revolute joints, in a prismatic joint or driven,
-    its joints at one point, or its new names taken."""
+    """Each flexible body that cannot be expanded: an axial link not with exactly two revolute joints, in a prismatic
+    joint or driven, its joints at one point, or its new names taken; a beam link as beam_problems says."""
     revolute, excluded = joint_lists(mechanism)
     problems = []
     for index, body in enumerate(mechanism.bodies):
-        if body.flexible is None:
+        if isinstance(body.flexible, BeamFlexibility):
+            problems += beam_problems(mechanism, index)
+        if not isinstance(body.flexible, AxialFlexibility):
             continue
         path, joints = ("bodies", index, "flexible"), revolute[body.name]
         if body.name in excluded:
@@ -234,10 +265,12 @@ def initial_tensions(document: dict, splits: list[LinkSplit], base_dir) -> list[
 
 
 def expanded_document(document: dict, mechanism, base_dir) -> dict:
-    """A copy of the document with every flexible body split, its spring carrying the rigid link's tension at
-    t = 0 (flexible_problems found none; `base_dir`: where the file's tables are)."""
+    """A copy of the document with every axial link split, its spring carrying the rigid link's tension at t = 0,
+    and every beam link cut into segments, unstressed at t = 0; with beam links, every body starts with the velocity
+    of the rigid mechanism at t = 0, so that no segment starts bending (the velocity nearest to the file's that the
+    chain allows would) (flexible_problems found none; `base_dir`: where the file's tables are)."""
     revolute, _ = joint_lists(mechanism)
-    flexible = [body for body in mechanism.bodies if body.flexible is not None]
+    flexible = [body for body in mechanism.bodies if isinstance(body.flexible, AxialFlexibility)]
     splits = [link_split(mechanism, body.name, revolute[body.name]) for body in flexible]
     tensions = initial_tensions(document, splits, base_dir)
     expanded = copy.deepcopy(document)
@@ -246,4 +279,259 @@ def expanded_document(document: dict, mechanism, base_dir) -> dict:
         split_link(expanded, split)
         set_spring(expanded, split, axial_stiffness(body.flexible, split.length), body.flexible.damping_ratio,
                    body.flexible.stiffness_damping)
+    beams = [body.name for body in mechanism.bodies if isinstance(body.flexible, BeamFlexibility)]
+    if beams:
+        velocities = rigid_velocities(mechanism, base_dir)
+        set_velocities(expanded, velocities)
+        for body in beams:
+            expand_beam(expanded, mechanism, body, velocities[body])
     return expanded
+
+
+# --- the beam element (rigid finite element method) ------------------------------------------------------------
+
+FIRST_CANTILEVER_ROOT = 1.8751040687  # β₁L of a clamped-free Euler–Bernoulli beam
+OUTSIDE_TOLERANCE = 1e-6  # × L: how far beyond the axis's ends a point may lie and still count as on the link
+
+
+@dataclass(frozen=True)
+class BeamLayout:
+    """A beam link's axis at t = 0 and its cut into n elements of length Δ = L/n (segments between element middles)."""
+
+    body: str
+    start: np.ndarray  # global, the axis's first end
+    direction: np.ndarray  # unit vector from the first end to the second
+    length: float  # L
+    elements: int  # n
+
+    @property
+    def cuts(self) -> np.ndarray:
+        """Arc lengths of the hinges: the element middles (k + 1/2) Δ."""
+        return (np.arange(self.elements) + 0.5) * self.length / self.elements
+
+    @property
+    def edges(self) -> np.ndarray:
+        """Arc lengths bounding the n + 1 segments: 0, the cuts, L."""
+        return np.concatenate([[0.0], self.cuts, [self.length]])
+
+    def arc_length(self, point) -> float:
+        return float(np.dot(np.asarray(point, float) - self.start, self.direction))
+
+    def distance_from_axis(self, point) -> float:
+        relative = np.asarray(point, float) - self.start
+        return abs(float(relative[0] * self.direction[1] - relative[1] * self.direction[0]))
+
+    def segment_of(self, point) -> int:
+        return int(np.searchsorted(self.cuts, self.arc_length(point)))
+
+    def on_axis(self, arc_length: float) -> np.ndarray:
+        return self.start + arc_length * self.direction
+
+
+def _axis_end(mechanism, poses, body: str, reference, path) -> np.ndarray:
+    """An axis end, globally at t = 0: a point named on the body, a named global point or [x, y]."""
+    if isinstance(reference, str) and reference in mechanism.body(body).points:
+        return poses.to_global(poses.index[body], mechanism.body(body).points[reference])
+    return poses.point_global(reference, poses.index[body], path)
+
+
+def beam_layout(mechanism, poses, body: str) -> BeamLayout | None:
+    """The layout of a beam link: its `axis:`, or its first and last joints; None without two distinct ends."""
+    flexibility = mechanism.body(body).flexible
+    if flexibility.axis is not None:
+        index = next(i for i, b in enumerate(mechanism.bodies) if b.name == body)
+        ends = [_axis_end(mechanism, poses, body, reference, ("bodies", index, "flexible", "axis", k))
+                for k, reference in enumerate(flexibility.axis)]
+    else:
+        joints = [a.location for a in attachments(mechanism, poses, body) if a.section == "joints"]
+        if len(joints) < 2:
+            return None
+        ends = [joints[0], joints[-1]]
+    axis = ends[1] - ends[0]
+    length = float(np.linalg.norm(axis))
+    if length < 1e-9:
+        return None
+    return BeamLayout(body, ends[0], axis / length, length, flexibility.segments)
+
+
+def density_along_axis(mass: float, inertia: float, first: float, last: float) -> np.ndarray:
+    """(a, b, c) of the density ρ(u) = a + b u + c u² (kg/m) on u ∈ [first, last] (u: arc length from the centre
+    of mass's projection) whose mass is m, centre of mass u = 0 and inertia about it ∫ ρ u² du = J."""
+    moments = [(last ** (k + 1) - first ** (k + 1)) / (k + 1) for k in range(5)]
+    system = np.array([[moments[i + j] for j in range(3)] for i in range(3)])
+    return np.linalg.solve(system, np.array([mass, 0.0, inertia]))
+
+
+def lowest_density(coefficients: np.ndarray, first: float, last: float) -> float:
+    """The least value of ρ(u) = a + b u + c u² on [first, last]."""
+    a, b, c = coefficients
+    candidates = [first, last] + ([-b / (2 * c)] if c != 0 and first < -b / (2 * c) < last else [])
+    return min(a + b * u + c * u * u for u in candidates)
+
+
+def segment_moments(coefficients: np.ndarray, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(masses, centres u, inertias about their centres) of the density between consecutive `edges` (u)."""
+    def integral(power: int) -> np.ndarray:
+        return sum(c * (edges[1:] ** (j + power + 1) - edges[:-1] ** (j + power + 1)) / (j + power + 1)
+                   for j, c in enumerate(coefficients))
+
+    masses = integral(0)
+    centres = integral(1) / masses
+    return masses, centres, integral(2) - masses * centres ** 2
+
+
+@dataclass(frozen=True)
+class BeamSegments:
+    """The segments of a beam link at t = 0 and where its centre of mass lies relative to its axis."""
+
+    layout: BeamLayout
+    names: list[str]
+    masses: np.ndarray
+    centres: np.ndarray  # global centres of mass
+    inertias: np.ndarray
+
+    def stiffness(self, flexibility) -> float:
+        """k = E I / Δ (N·m/rad)."""
+        bending = flexibility.youngs_modulus * flexibility.second_moment_of_area
+        return bending * self.layout.elements / self.layout.length
+
+    def damping(self, flexibility) -> float:
+        """c = β k, β = stiffness_damping + 2 ζ / ω₁ with ω₁ = (β₁L)² √(E I / (m L³)) the link's first cantilever
+        bending mode (N·m·s/rad)."""
+        bending = flexibility.youngs_modulus * flexibility.second_moment_of_area
+        first_mode = FIRST_CANTILEVER_ROOT ** 2 * math.sqrt(bending / (self.masses.sum() * self.layout.length ** 3))
+        proportional = flexibility.stiffness_damping + 2.0 * flexibility.damping_ratio / first_mode
+        return proportional * self.stiffness(flexibility)
+
+
+def beam_segments(mechanism, poses, layout: BeamLayout) -> BeamSegments | None:
+    """Segment masses, centres and inertias from the density fitted to the body's m, centre of mass and J; None when
+    no positive density of that form gives them. The segment holding the body's first joint keeps its name."""
+    body = mechanism.body(layout.body)
+    centre = np.asarray(body.position, float)
+    along = layout.arc_length(centre)
+    coefficients = density_along_axis(body.mass, body.inertia, -along, layout.length - along)
+    if lowest_density(coefficients, -along, layout.length - along) <= 0.0:
+        return None
+    masses, centres, inertias = segment_moments(coefficients, layout.edges - along)
+    joints = [a.location for a in attachments(mechanism, poses, layout.body) if a.section == "joints"]
+    named = layout.segment_of(joints[0] if joints else centre)
+    names = [layout.body if k == named else f"{layout.body}_s{k + 1}" for k in range(layout.elements + 1)]
+    return BeamSegments(layout, names, masses, centre + np.outer(centres, layout.direction), inertias)
+
+
+def beam_problems(mechanism, index: int) -> list[Problem]:
+    """What stops a beam link's expansion: no axis, an axis end or an attached point outside the link, an inertia no
+    positive density along the axis gives, names taken."""
+    from clearsim.assembly.build import initial_poses
+
+    body, poses = mechanism.bodies[index], initial_poses(mechanism)
+    path = ("bodies", index, "flexible")
+    layout = beam_layout(mechanism, poses, body.name)
+    if layout is None:
+        return [Problem(path, f"a beam link needs an axis of non-zero length: {body.name} has no `axis:` and not two "
+                        "joints at different points", "give `axis: [A, B]`, the link's two ends")]
+    centre = np.asarray(body.position, float)
+    attached = attachments(mechanism, poses, body.name)
+    extent = max([np.linalg.norm(a.location - centre) for a in attached]
+                 + [math.hypot(*point) for point in body.points.values()], default=0.0)
+    problems = [Problem(path + ("axis", k), f"the axis end of {body.name} lies {np.linalg.norm(end - centre):.4g} m "
+                        f"from its centre of mass, beyond the link's extent ({extent:.4g} m: its joints and points)",
+                        "give the link's two ends, on the link")
+                for k, end in enumerate((layout.start, layout.on_axis(layout.length)))
+                if body.flexible.axis is not None and np.linalg.norm(end - centre) > extent * (1 + 1e-9) + 1e-12]
+    tolerance = OUTSIDE_TOLERANCE * layout.length
+    for a in attached:
+        along, across = layout.arc_length(a.location), layout.distance_from_axis(a.location)
+        if not (-tolerance <= along <= layout.length + tolerance) or across > layout.length:
+            problems.append(Problem((a.section, a.index), f"its point on beam link {body.name} lies outside the link: "
+                                    f"{along:.4g} m along its axis of length {layout.length:.4g} m, {across:.4g} m off "
+                                    "it", f"attach it between the ends of {body.name}'s axis, or give {body.name} an "
+                                    "`axis:` that spans it"))
+    if problems:
+        return problems
+    if beam_segments(mechanism, poses, layout) is None:
+        uniform = body.mass * layout.length ** 2 / 12.0
+        return [Problem(("bodies", index, "inertia"), f"no positive mass distribution along {body.name}'s axis "
+                        f"(L = {layout.length:.4g} m) has its mass, centre of mass and inertia {body.inertia:.4g} "
+                        "kg·m²", f"give the link's inertia about its centre of mass (a uniform link: m L²/12 = "
+                        f"{uniform:.4g} kg·m²) or place its centre of mass nearer the middle of its axis")]
+    taken = {b.name for b in mechanism.bodies} | {j.name for j in mechanism.joints} | {f.name for f in mechanism.forces}
+    new = [f"{body.name}_{kind}{k + 1}" for kind in ("s", "hinge", "bend") for k in range(layout.elements + 1)]
+    clashes = sorted(set(new) & taken)
+    return [Problem(path, f"the names {', '.join(clashes)} the beam link's expansion makes are taken",
+                    "rename those entries")] if clashes else []
+
+
+def explicit_centres(document: dict, mechanism, poses, body: str) -> None:
+    """Sensors, loads and springs on `body` at its centre of mass (no point given) get that point, globally, so that
+    they stay there when the body is cut."""
+    centre = point_text(poses.pose(poses.index[body])[0])
+    for sensor, entry in zip(mechanism.sensors, document.get("sensors") or []):
+        if getattr(sensor, "body", None) == body and hasattr(sensor, "point") and sensor.point is None:
+            entry["point"] = centre
+    for force, entry in zip(mechanism.forces, document.get("forces") or []):
+        if isinstance(force, TWO_ENDED) and body in force.bodies and force.at is None and force.points is None:
+            entry["at"] = [point_text(poses.pose(poses.index[name])[0]) for name in force.bodies]
+        elif getattr(force, "body", None) == body and force.point is None:
+            entry["point"] = centre
+
+
+def rigid_velocities(mechanism, base_dir) -> dict[str, tuple[float, float, float]]:
+    """Each body's (v_x, v_y, ω) at t = 0 in the mechanism as given, its links rigid (made consistent by assembly);
+    the file's velocities when that model cannot be assembled."""
+    from clearsim.assembly.build import BuildError
+    from clearsim.assembly.system import assemble
+
+    try:
+        system = assemble(mechanism, base_dir)
+    except (BuildError, ClearsimError, ValueError):
+        return {b.name: (*b.velocity, b.angular_velocity) for b in mechanism.bodies}
+    return {name: tuple(float(v) for v in system.qd0[3 * k:3 * k + 3]) for k, name in enumerate(system.body_names)}
+
+
+def set_velocities(document: dict, velocities: dict[str, tuple[float, float, float]]) -> None:
+    """The bodies of `document` named in `velocities` start with those (v_x, v_y, ω)."""
+    for entry in document["bodies"]:
+        if entry["name"] in velocities:
+            vx, vy, rate = velocities[entry["name"]]
+            entry["velocity"] = [si_text(vx, "speed"), si_text(vy, "speed")]
+            entry["angular_velocity"] = si_text(rate, "angular_speed")
+
+
+def expand_beam(document: dict, mechanism, body: str, velocity: tuple[float, float, float]) -> None:
+    """Replace a beam link (beam_problems found none) by its segments, hinges and rotational springs in `document`;
+    they start straight, moving as the rigid link with `velocity` (v_x, v_y, ω)."""
+    from clearsim.assembly.build import initial_poses
+
+    poses = initial_poses(mechanism)
+    source = mechanism.body(body).model_copy(update={"velocity": velocity[:2], "angular_velocity": velocity[2]})
+    segments = beam_segments(mechanism, poses, beam_layout(mechanism, poses, body))
+    layout = segments.layout
+    explicit_centres(document, mechanism, poses, body)
+    retarget(document, {a.key: segments.names[layout.segment_of(a.location)]
+                        for a in attachments(mechanism, poses, body)})
+    rotation = np.array([[math.cos(source.angle), -math.sin(source.angle)],
+                         [math.sin(source.angle), math.cos(source.angle)]])
+    parts = []
+    for name, mass, centre, inertia in zip(segments.names, segments.masses, segments.centres, segments.inertias):
+        arm = centre - np.asarray(source.position, float)
+        velocity = np.asarray(source.velocity, float) + source.angular_velocity * np.array([-arm[1], arm[0]])
+        local = rotation.T @ arm
+        parts.append({"name": name, "mass": si_text(mass, "mass"), "inertia": si_text(inertia, "inertia"),
+                      "position": point_text(centre), "angle": si_text(source.angle, "angle"),
+                      "velocity": [si_text(v, "speed") for v in velocity],
+                      "angular_velocity": si_text(source.angular_velocity, "angular_speed"),
+                      "points": {key: point_text(np.asarray(point, float) - local)
+                                 for key, point in source.points.items()}})
+    position = next(i for i, b in enumerate(document["bodies"]) if b["name"] == body)
+    document["bodies"][position:position + 1] = parts
+    stiffness, damping = segments.stiffness(source.flexible), segments.damping(source.flexible)
+    names = segments.names
+    document["joints"] = (document.get("joints") or []) + [
+        {"name": f"{body}_hinge{k + 1}", "type": "revolute", "bodies": [names[k], names[k + 1]],
+         "at": point_text(layout.on_axis(cut))} for k, cut in enumerate(layout.cuts)]
+    document["forces"] = (document.get("forces") or []) + [
+        {"type": "rotational_spring", "name": f"{body}_bend{k + 1}", "bodies": [names[k], names[k + 1]],
+         "stiffness": si_text(stiffness, "rotational_stiffness"), "damping": si_text(damping, "rotational_damping")}
+        for k in range(layout.elements)]

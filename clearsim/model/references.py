@@ -234,14 +234,17 @@ def _doubly_driven(mechanism: schema.Mechanism) -> list[Problem]:
 
 
 def _check_force(names: _Names, force, path: tuple) -> list[Problem]:
-    if not isinstance(force, schema.TWO_ENDED):
+    if not isinstance(force, schema.TWO_BODY):
         return names.body(force.body, path + ("body",), ground_allowed=False) + names.global_point(
             force.point, path + ("point",))
-    kind = "spring" if isinstance(force, schema.SpringDamper) else "hydraulic cylinder"
+    kind = {schema.SpringDamper: "spring", schema.RotationalSpring: "rotational spring"}.get(type(force),
+                                                                                          "hydraulic cylinder")
     problems = [p for k in (0, 1) for p in names.body(force.bodies[k], path + ("bodies", k))]
     if force.bodies[0] == force.bodies[1]:
         problems.append(Problem(path + ("bodies",), f"a {kind} connects two different bodies; both are "
                                 f"'{force.bodies[0]}'", "name the two bodies it connects"))
+    if isinstance(force, schema.RotationalSpring):
+        return problems
     if force.at is not None and force.points is not None:
         return problems + [Problem(path + ("points",), f"a {kind}'s ends are given by `at:` or by `points:`, not both",
                                    "remove one of them")]

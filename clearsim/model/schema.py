@@ -33,6 +33,9 @@ from clearsim.units import (
     Pressure,
     Density,
     Volume,
+    RotationalDamping,
+    RotationalStiffness,
+    SecondMoment,
     Speed,
     SpringStiffness,
     Time,
@@ -197,6 +200,22 @@ class AxialFlexibility(Strict):
         return self
 
 
+class BeamFlexibility(Strict):
+    """A link that bends in the plane: rigid segments joined by pins and rotational springs k = E I / Δ (docs/model.md,
+    "Flexible links: the beam element")."""
+
+    model: Literal["beam"] = Field(description="beam: the link bends (Euler–Bernoulli) along its axis")
+    youngs_modulus: Pressure = Field(gt=0.0, description="Young's modulus E of the link's material")
+    second_moment_of_area: SecondMoment = Field(gt=0.0, description="second moment of area I of the section about its bending axis")
+    segments: int = Field(10, ge=2, le=200, description="number n of equal elements: n + 1 rigid segments (the two end ones half as long), n springs k = E I n / L")
+    axis: tuple[PointRef, PointRef] | None = Field(None, description="the link's two ends at t = 0: body points (by name) or global points; default its first and last joints")
+    damping_ratio: float = Field(0.0, ge=0.0, lt=1.0, description="damping ratio ζ of the link's first cantilever bending mode ω₁ = 3.516 √(E I / (m L³)): c = (2 ζ / ω₁) k at every spring")
+    stiffness_damping: Time = Field(0.0, ge=0.0, description="Rayleigh stiffness-proportional damping β: c = β k added at every spring")
+
+
+Flexibility = Annotated[Union[AxialFlexibility, BeamFlexibility], Field(discriminator="model")]
+
+
 class Body(Strict):
     name: str = Field(description="unique body name; `ground` is reserved")
     mass: Mass = Field(gt=0.0, description="mass m")
@@ -206,7 +225,7 @@ class Body(Strict):
     velocity: tuple[Speed, Speed] = Field((0.0, 0.0), description="centre-of-mass velocity at t = 0 (made consistent by assembly)")
     angular_velocity: AngularSpeed = Field(0.0, description="angular velocity at t = 0 (made consistent by assembly)")
     points: dict[str, Point] = Field(default_factory=dict, description="body-fixed points, body frame, from the centre of mass")
-    flexible: AxialFlexibility | None = Field(None, description="a compliant two-joint link; absent: rigid")
+    flexible: Flexibility | None = Field(None, description="a compliant link: axial (two joints) or beam; absent: rigid")
 
 
 # --- joints ---------------------------------------------------------------------------------------
@@ -336,6 +355,19 @@ class SpringDamper(Strict):
     damping: Damping = Field(0.0, description="damping coefficient c")
     free_length: Length | None = Field(None, ge=0.0, description="ℓ0; default: the length at t = 0")
     preload: Force = Field(0.0, description="constant tension added to the spring force")
+
+
+class RotationalSpring(Strict):
+    """Rotational spring-damper between two bodies: torque T = k (θ_j − θ_i − θ₀) + c (ω_j − ω_i) + preload, −T on the
+    second body and +T on the first."""
+
+    type: Literal["rotational_spring"] = Field(description="force kind")
+    name: str = Field(description="unique force name")
+    bodies: tuple[str, str] = Field(description="the two connected bodies [i, j]")
+    stiffness: RotationalStiffness = Field(0.0, description="rotational spring rate k")
+    damping: RotationalDamping = Field(0.0, description="rotational damping coefficient c")
+    free_angle: Angle | None = Field(None, description="θ₀; default: θ_j − θ_i at t = 0")
+    preload: Torque = Field(0.0, description="constant torque added to the spring torque")
 
 
 class TabulatedForce(Strict):
@@ -480,8 +512,9 @@ class HydraulicCylinder(Strict):
         return self
 
 
-AppliedForce = Annotated[Union[ConstantForce, SpringDamper, TabulatedForce, HydraulicCylinder], Field(discriminator="type")]
+AppliedForce = Annotated[Union[ConstantForce, SpringDamper, RotationalSpring, TabulatedForce, HydraulicCylinder], Field(discriminator="type")]
 TWO_ENDED = (SpringDamper, HydraulicCylinder)  # the forces between two bodies' points (`bodies:`, `at:`/`points:`)
+TWO_BODY = TWO_ENDED + (RotationalSpring,)  # every force between two bodies (`bodies:`)
 
 
 # --- sensors --------------------------------------------------------------------------------------
@@ -675,6 +708,9 @@ class Units(Strict):
     pressure: _unit_of("pressure") | None = _unit_field("pressure")
     spring_stiffness: _unit_of("spring_stiffness") | None = _unit_field("spring_stiffness")
     damping: _unit_of("damping") | None = _unit_field("damping")
+    second_moment: _unit_of("second_moment") | None = _unit_field("second_moment")
+    rotational_stiffness: _unit_of("rotational_stiffness") | None = _unit_field("rotational_stiffness")
+    rotational_damping: _unit_of("rotational_damping") | None = _unit_field("rotational_damping")
 
     @model_validator(mode="before")
     @classmethod

@@ -67,6 +67,7 @@ FIELD_LAYOUT = {
     "load_bodies": ("i8", 1), "load_params": ("f8", 2), "load_law": ("i8", 1),
     "spring_bodies": ("i8", 2), "spring_params": ("f8", 2),
     "hydraulic_bodies": ("i8", 2), "hydraulic_params": ("f8", 2), "hydraulic_laws": ("i8", 2),
+    "torsion_bodies": ("i8", 2), "torsion_params": ("f8", 2),
     "inverse_mass": ("f8", 1), "solve_blocks": ("f8", 3), "solve_bodies": ("i8", 2), "solve_schur": ("f8", 2),
     "solve_lower": ("f8", 2), "solve_envelope": ("i8", 1), "solve_body_start": ("i8", 1),
     "solve_entries": ("i8", 2), "solve_body_fill": ("i8", 1), "solve_vector": ("f8", 1),

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from clearsim.assembly.arrays import CLEARANCE_COLUMNS, LOAD_COLUMNS, SPRING_COLUMNS, KernelArrays, SystemArrays, for_kernels
+from clearsim.assembly.arrays import (CLEARANCE_COLUMNS, LOAD_COLUMNS, SPRING_COLUMNS, TORSION_COLUMNS, KernelArrays,
+                                      SystemArrays, for_kernels)
 from clearsim.assembly.constraints import (
     constraint_count, dense_jacobian, evaluate_acceleration_rhs, evaluate_constraints, evaluate_velocity_rhs,
 )
@@ -26,6 +27,7 @@ def mixed_system() -> KernelArrays:
         clearance_params=np.zeros((0, CLEARANCE_COLUMNS)),
         load_bodies=np.zeros(0, np.int64), load_params=np.zeros((0, LOAD_COLUMNS)), load_law=np.zeros(0, np.int64),
         spring_bodies=np.zeros((0, 2), np.int64), spring_params=np.zeros((0, SPRING_COLUMNS)),
+        torsion_bodies=np.zeros((0, 2), np.int64), torsion_params=np.zeros((0, TORSION_COLUMNS)),
     ))
 
 

@@ -425,7 +425,7 @@ def _diagnosis_progress():
 @user_errors
 def diagnose(
     config: Optional[Path] = ConfigArgument,
-    measured: Path = typer.Option(..., "--measured", help="Measured record: CSV (time + one column per sensor) or HDF5."),
+    measured: List[Path] = typer.Option(..., "--measured", help="Measured record: CSV (time + one column per sensor) or HDF5; again for repeats of the same test (the noise from their spread)."),
     overrides: List[str] = SetOption,
     mapping: List[str] = typer.Option([], "--map", help="Map a column to a sensor: --map Weg=sealing_rod_displacement (repeatable)."),
     candidates: Optional[str] = typer.Option(
@@ -442,8 +442,8 @@ def diagnose(
     from clearsim.diagnose.workflow import DiagnoseRequest, diagnose as run_diagnosis
     from clearsim.runner import BUNDLED_CONFIG
 
-    request = DiagnoseRequest(config or BUNDLED_CONFIG, measured, overrides, mapping, candidates, max_effects, out,
-                              workers, scheduler, lowpass, fit_top)
+    request = DiagnoseRequest(config or BUNDLED_CONFIG, measured[0], overrides, mapping, candidates, max_effects, out,
+                              workers, scheduler, lowpass, fit_top, measured[1:])
     progress, beat, update = _diagnosis_progress()
     with progress, beat:
         result = run_diagnosis(request, say=lambda text: console.print(text, highlight=False, soft_wrap=True),

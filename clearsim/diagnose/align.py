@@ -13,12 +13,13 @@ Everything here is data-only arithmetic (docs/diagnose.md §"The gap" and §"Noi
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
 from scipy.optimize import minimize_scalar
-from scipy.signal import butter, savgol_filter, sosfiltfilt, welch
+from scipy.signal import butter, savgol_filter, sosfiltfilt, spectrogram
+from scipy.stats import chi2
 
 SMOOTHER_ORDER = 5
 SMOOTHER_CUTOFF = 1.0 / 40.0  # of the sampling rate: the local cubic follows the signal below it
@@ -32,6 +33,15 @@ BANDWIDTH_DROP = 0.1  # the bench bandwidth ends where the noise floor has falle
 COMPARISON_BANDWIDTH = 500.0  # Hz: the motion and its lag, below the chaotic detail of single impacts
 MAX_OFFSET_FRACTION = 0.1  # the trigger offset is searched within ±10 % of the record length
 LOW_BAND_FACTOR = 0.4  # the screening band: 0.4 × the comparison band (frequency continuation, docs/diagnose.md §4)
+QUIET_SHARE = 0.3  # a segment is quiet where the model's own scatter is below 30 % of σ̂ (≤ 9 % of the noise variance)
+QUIET_ROUNDS = 3  # σ̂ from the quiet segments, the quiet segments from σ̂: rounds from the trend estimate down
+MIN_QUIET_SEGMENTS = 4  # fewer quiet Welch segments than this: the trend estimate stands
+HANN_BINS = 1.5  # equivalent noise bandwidth of the Hann window, in bins: neighbouring bins are correlated
+OVERLAP_VARIANCE = 1.056  # Welch (1967): variance of a 50 %-overlap Hann average over that of independent segments
+MEDIAN_EFFICIENCY = 1.0 / (4.0 * np.log(2.0) ** 2)  # of a median of exponential (χ²₂) bins against their mean: 0.52
+INTERVAL_LEVEL = 0.95  # the χ² interval reported on σ̂
+
+TREND, QUIET, REPEATS = "trend", "quiet", "repeats"  # the noise estimators (docs/diagnose.md §1)
 
 
 @dataclass(frozen=True)
@@ -43,6 +53,9 @@ class NoiseEstimate:
     samples: int  # N
     bandwidth: float | None  # Hz where the noise floor has dropped to 10 %, None: flat to Nyquist
     floor: float = 0.0  # one-sided noise density at low frequency, unit²/Hz
+    degrees_of_freedom: float = np.inf  # ν of the floor (σ̂² ~ σ² χ²_ν/ν): the χ² interval on σ̂
+    estimator: str = TREND  # TREND: the record minus its trend; QUIET: the residual against the model where the
+    # model is quiet; REPEATS: the difference of repeated records
 
     def filtered(self, cutoff: float, rate: float) -> "NoiseEstimate":
         """The same noise after the comparison low-pass: σ² = S_n(0)·B_eq(cutoff) where that is below
@@ -50,8 +63,17 @@ class NoiseEstimate:
         band = equivalent_bandwidth(cutoff)
         if self.floor <= 0.0 or self.floor * band >= self.std ** 2:
             return self
-        return NoiseEstimate(float(np.sqrt(self.floor * band)), self.samples * min(1.0, 2.0 * band / rate),
-                             self.samples, cutoff, self.floor)
+        return replace(self, std=float(np.sqrt(self.floor * band)),
+                       effective_samples=self.samples * min(1.0, 2.0 * band / rate), bandwidth=cutoff)
+
+    def interval(self, level: float = INTERVAL_LEVEL) -> tuple[float, float]:
+        """The χ² interval on σ̂ at `level`: σ̂ √(ν/χ²_ν(1 − α/2)) … σ̂ √(ν/χ²_ν(α/2))."""
+        if not np.isfinite(self.degrees_of_freedom):
+            return self.std, self.std
+        tail = 0.5 * (1.0 - level)
+        nu = self.degrees_of_freedom
+        return (float(self.std * np.sqrt(nu / chi2.ppf(1.0 - tail, nu))),
+                float(self.std * np.sqrt(nu / chi2.ppf(tail, nu))))
 
 
 def smoother_window(rate_samples: int) -> int:
@@ -69,28 +91,105 @@ def smoother_response(window: int, frequencies: np.ndarray, rate: float) -> np.n
     return np.abs(np.exp(-2j * np.pi * np.outer(frequencies / rate, lags)) @ weights)
 
 
-def estimate_noise(values: np.ndarray, rate: float) -> NoiseEstimate:
+def estimate_noise(values: np.ndarray | list[np.ndarray], rate: float, quiet: np.ndarray | None = None,
+                   estimator: str = TREND) -> NoiseEstimate:
     """σ̂ and n_eff of a record: the high-pass scatter's median Welch spectrum, divided by the
-    smoother's high-pass response and continued flat below its cut-off, integrated."""
-    count = len(values)
+    smoother's high-pass response and continued flat below its cut-off, integrated.
+
+    values: one signal, or several of one length whose segments all count (the scaled differences of repeats).
+    quiet: per sample, True where the scatter is noise alone; only Welch segments wholly inside it count
+    (fewer than MIN_QUIET_SEGMENTS: all count, and the estimator is TREND)."""
+    signals = [np.asarray(v, dtype=float) for v in (values if isinstance(values, list) else [values])]
+    count = len(signals[0])
     window = smoother_window(count)
     if window <= SMOOTHER_ORDER + 1:
-        scatter = values - np.mean(values)
-        return NoiseEstimate(float(np.std(scatter)), float(count), count, None)
-    scatter = values - savgol_filter(values, window, SMOOTHER_ORDER, mode="interp")
-    frequencies, density = welch(scatter, fs=rate, nperseg=min(WELCH_SEGMENT, count), average="median")
+        scatter = signals[0] - np.mean(signals[0])
+        return NoiseEstimate(float(np.std(scatter)), float(count), count, None, degrees_of_freedom=count - 1.0)
+    scatters = [v - savgol_filter(v, window, SMOOTHER_ORDER, mode="interp") for v in signals]
+    frequencies, segments = segment_spectra(scatters, rate, quiet)
+    if quiet is not None and len(segments) < MIN_QUIET_SEGMENTS:
+        frequencies, segments = segment_spectra(scatters, rate, None)
+        estimator = TREND
+    density = np.median(segments, axis=0) / _median_bias(len(segments))
     passed = (1.0 - smoother_response(window, frequencies, rate)) ** 2
     valid = passed > PASSED
     if not np.any(valid):
-        return NoiseEstimate(float(np.std(scatter)), float(count), count, None)
+        return NoiseEstimate(float(np.std(scatters[0])), float(count), count, None, estimator=estimator)
     noise = np.where(valid, density / np.where(valid, passed, 1.0), 0.0)
-    level = _floor_level(frequencies, noise, valid)
+    level, bins = _floor_level(frequencies, noise, valid)
     bandwidth = _bandwidth(frequencies, noise, level)
     noise = np.where(valid, np.minimum(noise, LINE_FACTOR * level), level)  # lines far above the floor are signal
     variance = float(np.trapezoid(noise, frequencies))
     white = 2.0 * variance / rate
     effective = count * min(1.0, white / level) if level > 0.0 else float(count)
-    return NoiseEstimate(float(np.sqrt(max(variance, 0.0))), effective, count, bandwidth, level)
+    return NoiseEstimate(float(np.sqrt(max(variance, 0.0))), effective, count, bandwidth, level,
+                         floor_degrees_of_freedom(len(segments), bins), estimator)
+
+
+def floor_degrees_of_freedom(segments: int, bins: int) -> float:
+    """ν of the noise floor, the mean over `bins` Hann bins of each bin's median over `segments` Welch segments:
+    2 per bin and segment, the segments' overlap (OVERLAP_VARIANCE), the median's efficiency (MEDIAN_EFFICIENCY)
+    and the correlation of neighbouring bins (HANN_BINS) taken off."""
+    return 2.0 * segments / OVERLAP_VARIANCE * MEDIAN_EFFICIENCY * max(bins, 1) / HANN_BINS
+
+
+def segment_spectra(scatters: list[np.ndarray], rate: float, quiet: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided density of every Welch segment (WELCH_SEGMENT-sample Hann, half overlapping, mean removed) of each
+    scatter signal; with `quiet`, only the segments whose samples are all quiet."""
+    length = min(WELCH_SEGMENT, len(scatters[0]))
+    rows = []
+    for scatter in scatters:
+        frequencies, _, density = spectrogram(scatter, fs=rate, window="hann", nperseg=length, noverlap=length // 2,
+                                              detrend="constant", scaling="density", mode="psd")
+        starts = np.arange(density.shape[1]) * (length - length // 2)
+        keep = [quiet is None or bool(np.all(quiet[k:k + length])) for k in starts]
+        rows += [density[:, j] for j in np.flatnonzero(keep)]
+    return frequencies, np.array(rows).reshape(len(rows), len(frequencies))
+
+
+def _median_bias(count: int) -> float:
+    """Median of `count` χ²₂ variables over their mean (scipy's Welch median correction): 1 − 1/2 + 1/3 − …"""
+    odd = 2.0 * np.arange(1.0, (count - 1) // 2 + 1)
+    return float(1.0 + np.sum(1.0 / (odd + 1.0) - 1.0 / odd))
+
+
+def repeat_noise(records: list[np.ndarray], rate: float) -> NoiseEstimate:
+    """σ̂ from repeated records of one test on one grid: the deviations from their mean, y_i − ȳ, scaled by
+    √(n/(n − 1)) to the noise of one record, hold the noise alone wherever the repeats agree (whatever the model);
+    their segments together give the estimate (ν grows with the n − 1 independent deviations)."""
+    stacked = np.array(records, dtype=float)
+    count = len(stacked)
+    scale = np.sqrt(count / (count - 1.0))
+    deviations = [scale * (row - stacked.mean(axis=0)) for row in stacked]
+    estimate = estimate_noise(deviations, rate, estimator=REPEATS)
+    return replace(estimate, degrees_of_freedom=estimate.degrees_of_freedom * (count - 1) / count)
+
+
+def quiet_samples(model: np.ndarray, rate: float, level: float) -> np.ndarray:
+    """Per sample, True where the model's own scatter about its trend, RMS over the surrounding Welch segment, is
+    below QUIET_SHARE × `level` (σ̂): no rattle or ringing of the model there."""
+    window = smoother_window(len(model))
+    if window <= SMOOTHER_ORDER + 1:
+        return np.ones(len(model), dtype=bool)
+    scatter = model - savgol_filter(model, window, SMOOTHER_ORDER, mode="interp")
+    length = min(WELCH_SEGMENT, len(model))
+    local = np.sqrt(np.convolve(scatter ** 2, np.ones(length) / length, mode="same"))
+    return local < QUIET_SHARE * level
+
+
+def model_quiet_noise(record: np.ndarray, model: np.ndarray, rate: float, start: NoiseEstimate) -> NoiseEstimate:
+    """σ̂ from the residual against the model (record − model, both unfiltered) where the model is quiet
+    (`quiet_samples`): rattle and ringing the model predicts are left out, the residual there is the noise. The quiet
+    part is found from σ̂ and σ̂ from the quiet part, QUIET_ROUNDS rounds from `start` (the trend estimate, which a
+    rattle raises); too few quiet segments: `start` stands."""
+    estimate = start
+    for _ in range(QUIET_ROUNDS):
+        quiet = quiet_samples(model, rate, estimate.std)
+        found = estimate_noise(record - model, rate, quiet, QUIET)
+        if found.estimator != QUIET:
+            return start
+        estimate = found
+    return estimate
 
 
 def equivalent_bandwidth(cutoff: float) -> float:
@@ -100,10 +199,10 @@ def equivalent_bandwidth(cutoff: float) -> float:
     return cutoff * quad(lambda x: 1.0 / (1.0 + x ** (2 * COMPARISON_FILTER_ORDER)) ** 2, 0.0, np.inf)[0]
 
 
-def _floor_level(frequencies: np.ndarray, noise: np.ndarray, valid: np.ndarray) -> float:
-    """The flat noise floor: the mean density over the flat part of the passband (up to FLAT_PART of
-    the bandwidth), spectral lines above LINE_FACTOR × the median left out. Two rounds: the lowest
-    valid bins give the bandwidth, the bandwidth gives the flat part."""
+def _floor_level(frequencies: np.ndarray, noise: np.ndarray, valid: np.ndarray) -> tuple[float, int]:
+    """The flat noise floor and the number of bins it is the mean of: the mean density over the flat part of the
+    passband (up to FLAT_PART of the bandwidth), spectral lines above LINE_FACTOR × the median left out. Two rounds:
+    the lowest valid bins give the bandwidth, the bandwidth gives the flat part."""
     first = np.nonzero(valid)[0][:FLOOR_BINS]
     bandwidth = _bandwidth(frequencies, noise, float(np.median(noise[first])))
     flat = valid & (frequencies <= FLAT_PART * (bandwidth or frequencies[-1] / FLAT_PART))
@@ -111,7 +210,7 @@ def _floor_level(frequencies: np.ndarray, noise: np.ndarray, valid: np.ndarray) 
         flat = valid
     typical = float(np.median(noise[flat]))
     kept = noise[flat][noise[flat] <= LINE_FACTOR * typical]
-    return float(np.mean(kept)) if len(kept) else typical
+    return (float(np.mean(kept)), len(kept)) if len(kept) else (typical, 1)
 
 
 def _bandwidth(frequencies: np.ndarray, noise: np.ndarray, level: float) -> float | None:
@@ -146,6 +245,7 @@ class Record:
     noise: dict[str, NoiseEstimate]
     cutoff: float | None  # comparison low-pass (Hz) applied to the model's prediction, None: none
     low_band: "Record | None" = None  # the same record in the screening band (LOW_BAND_FACTOR × cutoff)
+    unfiltered: dict[str, np.ndarray] = field(default_factory=dict)  # the record on the grid, before any low-pass
 
     @property
     def weights(self) -> dict[str, float]:
@@ -157,26 +257,33 @@ class Record:
         return float(sum(n.effective_samples for n in self.noise.values()))
 
 
-def prepare_record(time: np.ndarray, values: dict[str, np.ndarray], cutoff: float | None = None) -> Record:
-    """Resample onto a uniform grid (the record's median step), estimate each sensor's noise, and
+def uniform_grid(time: np.ndarray) -> np.ndarray:
+    """The record's uniform grid: its first time in steps of its median step."""
+    step = float(np.median(np.diff(time)))
+    return time[0] + step * np.arange(int(np.floor((time[-1] - time[0]) / step + 1e-9)) + 1)
+
+
+def prepare_record(time: np.ndarray, values: dict[str, np.ndarray], cutoff: float | None = None,
+                   noise: dict[str, NoiseEstimate] | None = None) -> Record:
+    """Resample onto a uniform grid (`uniform_grid`), estimate each sensor's noise, and
     low-pass the record at the comparison bandwidth (model predictions get the same filter); the
     record in the screening band (LOW_BAND_FACTOR × that bandwidth) rides along as `low_band`.
 
     cutoff: the comparison bandwidth (Hz); None: COMPARISON_BANDWIDTH, or the record's own
     bandwidth where that is narrower.
+    noise: the noise of each sensor on that grid (repeats, or the residual against a model); None: the record
+    minus its trend (TREND).
     """
-    step = float(np.median(np.diff(time)))
-    grid = time[0] + step * np.arange(int(np.floor((time[-1] - time[0]) / step + 1e-9)) + 1)
+    grid = uniform_grid(time)
     uniform = {s: np.interp(grid, time, v) for s, v in values.items()}
-    rate = 1.0 / step
-    noise = {s: estimate_noise(v, rate) for s, v in uniform.items()}
+    rate = 1.0 / (grid[1] - grid[0])
+    noise = dict(noise) if noise is not None else {s: estimate_noise(v, rate) for s, v in uniform.items()}
     if cutoff is None:
         seen = [n.bandwidth for n in noise.values() if n.bandwidth is not None]
         cutoff = min([COMPARISON_BANDWIDTH, *seen])
     for sensor, estimate in noise.items():
         if not estimate.std > 0.0:
-            noise[sensor] = NoiseEstimate(_quantisation_floor(uniform[sensor]), estimate.effective_samples,
-                                          estimate.samples, estimate.bandwidth)
+            noise[sensor] = replace(estimate, std=_quantisation_floor(uniform[sensor]), floor=0.0)
     record = _in_band(grid, rate, uniform, noise, cutoff)
     record.low_band = _in_band(grid, rate, uniform, noise, LOW_BAND_FACTOR * (record.cutoff or 0.5 * rate))
     return record
@@ -187,9 +294,27 @@ def _in_band(grid: np.ndarray, rate: float, uniform: dict[str, np.ndarray], nois
     """The record low-passed at `cutoff` (none at or above Nyquist), with its noise seen through that filter."""
     cutoff = cutoff if cutoff < 0.5 * rate else None
     if cutoff is None:
-        return Record(grid, rate, dict(uniform), dict(noise), None)
+        return Record(grid, rate, dict(uniform), dict(noise), None, unfiltered=uniform)
     return Record(grid, rate, {s: lowpass(v, cutoff, rate) for s, v in uniform.items()},
-                  {s: n.filtered(cutoff, rate) for s, n in noise.items()}, cutoff)
+                  {s: n.filtered(cutoff, rate) for s, n in noise.items()}, cutoff, unfiltered=uniform)
+
+
+def residual_noise(record: Record, model_time: np.ndarray, model: dict[str, np.ndarray],
+                   offset: float) -> dict[str, NoiseEstimate]:
+    """Per sensor, the lower of two estimates that each hold the noise and something more: the record minus its trend
+    (TREND: and the record's own rattle) and the residual against the model at trigger offset `offset`, low-passed at
+    the record's bandwidth, where the model is quiet if enough of it is, else all of it (QUIET: and what the model
+    misses). The model's dynamics, rattle included, are left out of the second."""
+    trend = {s: estimate_noise(v, record.rate) for s, v in record.unfiltered.items()}
+    chosen = {}
+    for sensor, values in record.unfiltered.items():
+        prediction = lowpass(np.interp(record.time - offset, model_time, model[sensor]), trend[sensor].bandwidth,
+                             record.rate)  # the bench's filter, as far as the record shows it
+        against = model_quiet_noise(values, prediction, record.rate, trend[sensor])
+        if against.estimator != QUIET:
+            against = estimate_noise(values - prediction, record.rate, estimator=QUIET)
+        chosen[sensor] = min(trend[sensor], against, key=lambda estimate: estimate.std)
+    return chosen
 
 
 def _quantisation_floor(values: np.ndarray) -> float:
@@ -286,3 +411,67 @@ def fit_at(record: Record, model_time: np.ndarray, model: dict[str, np.ndarray],
     residual = residuals(record, predict(record, model_time, model, offset))
     gaps = sensor_gaps(record, residual)
     return Fit(float(offset), chi_square(record, residual), gaps, combined_gap(gaps))
+
+
+UNEXPLAINED_LEVEL = 0.01  # false-alarm rate of the "unexplained" test over all sensors together (Bonferroni)
+DECAYED_LAGS = 10  # the residual's autocorrelation has decayed where it stays within its noise for this many lags
+
+
+@dataclass(frozen=True)
+class NoiseTest:
+    """Is a residual consistent with the noise? Per sensor, gap² = mean(r²)/σ̂² against F(n_eff, ν): the residual's
+    squares are worth n_eff independent ones (from its autocorrelation), σ̂² has ν degrees of freedom."""
+
+    gaps: dict  # sensor → gap (RMS residual / σ̂)
+    effective_samples: dict  # sensor → n_eff of the residual
+    p_values: dict  # sensor → P(gap this large | noise alone)
+    level: float = UNEXPLAINED_LEVEL
+
+    @property
+    def failing(self) -> list[str]:
+        """The sensors whose residual is beyond the noise at `level` (shared among the sensors)."""
+        return [s for s, p in self.p_values.items() if p < self.level / len(self.p_values)]
+
+    @property
+    def consistent(self) -> bool:
+        return not self.failing
+
+
+def residual_effective_samples(residual: np.ndarray) -> float:
+    """n_eff = N / (1 + 2 Σ_k (1 − k/N) ρ_k²): the independent samples whose squares vary as much as the residual's
+    (Var Σ r² = 2σ⁴ N (1 + 2 Σ_k (1 − k/N) ρ_k²) for a Gaussian sequence), ρ_k its sample autocorrelation, summed up
+    to the first lag from which |ρ_k| stays below 2/√N for DECAYED_LAGS lags (beyond it the sample ρ_k is its own
+    noise; a band-limited residual's ρ_k crosses zero between its lobes, so one lag below is not enough)."""
+    count = len(residual)
+    centred = residual - np.mean(residual)
+    spectrum = np.fft.rfft(centred, 2 * count)
+    correlation = np.fft.irfft(np.abs(spectrum) ** 2)[:count]
+    if correlation[0] <= 0.0:
+        return float(count)
+    rho = correlation / correlation[0]
+    quiet = np.abs(rho) < 2.0 / np.sqrt(count)
+    runs = np.convolve(quiet.astype(float), np.ones(DECAYED_LAGS), mode="valid") >= DECAYED_LAGS
+    last = int(np.argmax(runs[1:])) + 1 if np.any(runs[1:]) else count
+    lags = np.arange(1, last)
+    return float(count / (1.0 + 2.0 * np.sum((1.0 - lags / count) * rho[1:last] ** 2)))
+
+
+def settled(record: Record, residual: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The residual without the comparison filter's start-up at each end (1/f_c): there the filtered record holds the
+    noise of its first or last sample unfiltered (the filter's padding repeats it), up to √(f_s/2f_c) times σ̂."""
+    if record.cutoff is None:
+        return residual
+    edge = int(np.ceil(record.rate / record.cutoff))
+    return {s: r[edge:len(r) - edge] if len(r) > 4 * edge else r for s, r in residual.items()}
+
+
+def noise_test(record: Record, residual: dict[str, np.ndarray]) -> NoiseTest:
+    """The residual (in the comparison band, `settled`) against the noise, per sensor: p = P(F(n_eff, ν) ≥ gap²)."""
+    from scipy.stats import f as fisher
+
+    residual = settled(record, residual)
+    gaps = sensor_gaps(record, residual)
+    effective = {s: residual_effective_samples(r) for s, r in residual.items()}
+    p_values = {s: float(fisher.sf(gaps[s] ** 2, effective[s], min(record.noise[s].degrees_of_freedom, 1e9)))
+                for s in residual}
+    return NoiseTest(gaps, effective, p_values)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from clearsim.diagnose.align import predict, residuals
+from clearsim.diagnose.align import INTERVAL_LEVEL, QUIET, REPEATS, TREND, predict, residuals
 from clearsim.diagnose.evaluate import document_text
 from clearsim.diagnose.search import SIGNIFICANCE, JointFit, Scored, smoothed_interval
 from clearsim.diagnose.workflow import Diagnosis, Effect, effect_line, found_effect, refit_line
@@ -19,6 +19,8 @@ from clearsim.io.hdf5 import keep_as_previous
 from clearsim.plot.style import LEGEND_WIDTH, legend_beside, new_figure, set_title, wrap_label
 
 REPORT, JSON = "report.md", "diagnosis.json"
+NOISE_SOURCES = {TREND: "the record minus its trend", QUIET: "the residual against the model as given",
+                 REPEATS: "the spread of the repeated records"}
 GAP_AXIS_CHARACTERS = 55  # characters of tick label that fit side by side under the gap axis
 
 
@@ -76,8 +78,11 @@ def diagnosis_document(d: Diagnosis) -> dict:
         "gap_before": d.before.gap, "gap_after": d.after.gap,
         "gaps": {s: {"before": d.before.gaps[s], "after": d.after.gaps[s]} for s in d.sensors},
         "trigger_offset_s": {"before": d.before.offset, "after": d.after.offset},
-        "noise": {s: {"std": n.std, "effective_samples": n.effective_samples, "samples": n.samples}
+        "noise": {s: {"std": n.std, "interval": list(n.interval()), "interval_level": INTERVAL_LEVEL,
+                      "degrees_of_freedom": n.degrees_of_freedom, "estimator": n.estimator,
+                      "effective_samples": n.effective_samples, "samples": n.samples}
                   for s, n in d.record.noise.items()},
+        "repeats": [str(path) for path in d.request.repeats],
         "comparison_lowpass_hz": d.record.cutoff,
         "joint_refit": _joint(d.joint),
         "iterations": [{"gap": it.baseline.gap, "found": _effect(found_effect(it.found, it.baseline)) if it.found else None,
@@ -135,12 +140,14 @@ def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
     out = [f"# Diagnosis of {Path(d.request.config).name} against {Path(d.request.measured).name}", "",
            f"**{verdict(d)}**", "",
            f"{d.simulations} simulations, {d.wall_time:.0f} s. Gap = RMS residual / noise level (docs/diagnose.md).", "",
-           "| sensor | noise σ̂ | n_eff / N | gap before | gap after |", "|---|---|---|---|---|"]
+           f"| sensor | noise σ̂ ({INTERVAL_LEVEL:.0%} interval) | estimated from | n_eff / N | gap before | gap after |",
+           "|---|---|---|---|---|---|"]
     for s in d.sensors:
         n = d.record.noise[s]
-        out.append(f"| {s} | {n.std:.3g} {d.units.get(s, '')} | {n.effective_samples:.0f} / {n.samples} | "
-                   f"{d.before.gaps[s]:.3g} | {d.after.gaps[s]:.3g} |")
-    out += [f"| combined | | | {d.before.gap:.3g} | {d.after.gap:.3g} |", "",
+        low, high = n.interval()
+        out.append(f"| {s} | {n.std:.3g} ({low:.3g}–{high:.3g}) {d.units.get(s, '')} | {NOISE_SOURCES[n.estimator]} | "
+                   f"{n.effective_samples:.0f} / {n.samples} | {d.before.gaps[s]:.3g} | {d.after.gaps[s]:.3g} |")
+    out += [f"| combined | | | | {d.before.gap:.3g} | {d.after.gap:.3g} |", "",
             f"Trigger offset: {d.before.offset * 1e3:.3f} ms (fitted as a nuisance).", "", *_joint_lines(d),
             "## Where the model and the record disagree (before)", "",
             "| sensor | feature | measured | model | unit |", "|---|---|---|---|---|"]

@@ -19,12 +19,13 @@ from typing import Callable
 import numpy as np
 import yaml
 
-from clearsim.diagnose.align import Fit, Record, predict, prepare_record, residuals
+from clearsim.diagnose.align import (Fit, NoiseEstimate, Record, fit_offset, predict, prepare_record, repeat_noise,
+                                    residual_noise, residuals)
 from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for, with_effects
 from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
 from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
-from clearsim.diagnose.search import (SIGNIFICANCE, JointFit, Point, Scored, SearchProgress, Tracked, halves_improved,
+from clearsim.diagnose.search import (AS_GIVEN, SIGNIFICANCE, JointFit, Point, Scored, SearchProgress, Tracked, halves_improved,
                                      judge, low_band_best, mark_ties, refine, refit_jointly, score_point, screen,
                                      seen_by_sensors, setting, to_fit)
 from clearsim.errors import ClearsimError, did_you_mean
@@ -55,6 +56,7 @@ class DiagnoseRequest:
     scheduler: str | None = None
     lowpass: str | None = None  # the bench's filter if known
     fit_top: int = FIT_TOP
+    repeats: list[Path] = field(default_factory=list)  # further records of the same test: the noise from their spread
 
 
 @dataclass
@@ -220,9 +222,9 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
         raise DiagnoseError(f"--lowpass {request.lowpass!r}: below {MIN_CYCLES} cycles over the record "
                             f"({span * 1e3:.4g} ms), the comparison would keep no independent samples; give at "
                             f"least {MIN_CYCLES / span:.3g} Hz, or leave the option out to estimate it from the record")
+    repeats = [read_repeat(path, measured, loaded.mechanism, request) for path in request.repeats]
     record = prepare_record(measured.time, measured.values, cutoff)
     units = model_sensor_units(loaded.mechanism)
-    say(_record_line(record))
     document = yaml.safe_load(loaded.resolved_yaml)
     original = document
     folder = Path(request.out) if request.out else default_folder(request)
@@ -232,6 +234,10 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
     iterations: list[Iteration] = []
     joint = None
     try:
+        evaluator.stage("estimating the noise")
+        noise = record_noise(evaluator, record, sensors, document, repeats, request)
+        record = prepare_record(measured.time, measured.values, cutoff, noise)
+        say(_record_line(record))
         found_keys: set = set()
         for number in range(1, request.max_effects + 1):
             iteration = _iterate(evaluator, record, sensors, document, kinds, found_keys, units, request, number, say)
@@ -281,8 +287,40 @@ def refit_line(joint: JointFit, effects: list[Effect]) -> str:
             f"gap {joint.start_point.fit.gap:.3g} → {joint.best.fit.gap:.3g}")
 
 
+def read_repeat(path: Path, measured: MeasuredData, mechanism, request: DiagnoseRequest) -> MeasuredData:
+    """A further record of the same test (`--measured` given again): the same sensors, over the first record's span."""
+    repeat = read_measured(path, model_sensor_units(mechanism), parse_mapping(request.mapping), required=list(measured.values))
+    step = float(np.median(np.diff(measured.time)))
+    if repeat.time[0] > measured.time[0] + step or repeat.time[-1] < measured.time[-1] - step:
+        raise DiagnoseError(f"{path}: a repeat spans {_ms(repeat.time[0])} to {_ms(repeat.time[-1])}, the first record "
+                            f"({request.measured}) {_ms(measured.time[0])} to {_ms(measured.time[-1])}; repeats of one "
+                            "test must cover its span (cut the first record, or give a repeat that covers it)")
+    return repeat
+
+
+def record_noise(evaluator, record: Record, sensors: list[str], document: dict, repeats: list[MeasuredData],
+                 request: DiagnoseRequest) -> dict[str, NoiseEstimate]:
+    """σ̂ of each sensor (docs/diagnose.md §1): from the spread of the repeated records when there are any, else the
+    lower of the record minus its trend and the residual against the model as given (one run: the screening reuses
+    it), which leaves out the model's own rattle and ringing."""
+    if repeats:
+        return {s: repeat_noise([record.unfiltered[s]] + [np.interp(record.time, r.time, r.values[s]) for r in repeats],
+                                record.rate) for s in sensors}
+    model = evaluator.evaluate([document], lambda i, prediction: prediction, [AS_GIVEN])[0]
+    check_model(model, request)
+    fit = fit_offset(record, model.time, {s: model.sensors[s] for s in sensors})
+    return residual_noise(record, model.time, model.sensors, fit.offset)
+
+
+def check_model(prediction: Prediction, request: DiagnoseRequest) -> None:
+    if not prediction.ok:
+        raise DiagnoseError(f"{request.config}: the model does not run to the end ({prediction.error}); "
+                            "fix it with `clearsim run` first")
+
+
 def _record_line(record: Record) -> str:
-    parts = [f"{s}: σ̂ = {n.std:.3g}, n_eff = {n.effective_samples:.0f} of {n.samples}" for s, n in record.noise.items()]
+    parts = [f"{s}: σ̂ = {n.std:.3g} ({n.interval()[0]:.3g}–{n.interval()[1]:.3g}, {n.estimator}), "
+             f"n_eff = {n.effective_samples:.0f} of {n.samples}" for s, n in record.noise.items()]
     band = f"; comparison low-pass {record.cutoff:.0f} Hz" if record.cutoff else ""
     return f"record: {len(record.time)} samples at {record.rate:.0f} Hz{band}; " + "; ".join(parts)
 
@@ -292,14 +330,10 @@ def _mechanism(document: dict, request: DiagnoseRequest):
 
 
 def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, request, number, say) -> Iteration:
-    def check_model(prediction: Prediction) -> None:
-        if not prediction.ok:
-            raise DiagnoseError(f"{request.config}: the model does not run to the end ({prediction.error}); "
-                                "fix it with `clearsim run` first")
-
     candidates = [c for c in candidates_for(_mechanism(document, request), document, kinds, Path(request.config).parent) if c.key not in found_keys]
     evaluator.stage(f"iteration {number}: screening {candidates_count(len(candidates))}")
-    base_point, scored = screen(evaluator, record, sensors, candidates, document, check_model)
+    base_point, scored = screen(evaluator, record, sensors, candidates, document,
+                                lambda prediction: check_model(prediction, request))
     base_prediction = base_point.prediction
     baseline = base_point.fit
     aligned = predict(record, base_prediction.time, {s: base_prediction.sensors[s] for s in sensors}, baseline.offset)

@@ -55,8 +55,9 @@ def test_a_diagnosis_reports_every_run_it_plans_and_its_best_model(tmp_path, mon
     assert final.planned == sum(asked) and final.done == final.planned  # every run asked for, and each finished
     assert all(a.done <= a.planned for a in states)
     assert [s.done for s in states] == sorted(s.done for s in states)
-    stages = [s.stage for s in states]
-    assert stages[0].startswith("iteration 1: screening") and stages[-1].startswith("iteration 1: fitting")
+    stages = list(dict.fromkeys(s.stage for s in states))
+    assert stages[0] == "estimating the noise"  # the model as given runs first: σ̂ from the residual against it
+    assert stages[1].startswith("iteration 1: screening") and stages[-1].startswith("iteration 1: fitting")
     best = min((p for s in result.iterations[0].ranked for p in s.points if p.fit is not None),
                key=lambda p: p.fit.gap)
     assert np.isclose(final.best_gap, min(best.fit.gap, result.before.gap))

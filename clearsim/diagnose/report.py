@@ -14,7 +14,9 @@ import numpy as np
 from clearsim.diagnose.align import INTERVAL_LEVEL, QUIET, REPEATS, TREND, predict, residuals
 from clearsim.diagnose.evaluate import document_text
 from clearsim.diagnose.search import SIGNIFICANCE, JointFit, Scored, smoothed_interval
-from clearsim.diagnose.workflow import Diagnosis, Effect, effect_line, found_effect, refit_line
+from clearsim.diagnose.search import robust_to_perturbations, significant_on_both_halves
+from clearsim.diagnose.workflow import (Diagnosis, Effect, confirmed, effect_line, explained_share, found_effect,
+                                       refit_line)
 from clearsim.io.hdf5 import keep_as_previous
 from clearsim.plot.style import LEGEND_WIDTH, legend_beside, new_figure, set_title, wrap_label
 
@@ -24,7 +26,8 @@ NOISE_SOURCES = {TREND: "the record minus its trend", QUIET: "the residual again
 GAP_AXIS_CHARACTERS = 55  # characters of tick label that fit side by side under the gap axis
 
 
-def _effect(effect: Effect) -> dict:
+def _effect(effect: Effect, d: Diagnosis | None = None) -> dict:
+    """An effect as in diagnosis.json; with the diagnosis `d`, its verdict too (confirmed, and on what)."""
     c, scored = effect.candidate, effect.scored
     low, high = effect.interval
     return {"kind": c.kind, "target": c.target, "parameters": {c.parameter: effect.value},
@@ -32,7 +35,25 @@ def _effect(effect: Effect) -> dict:
             "ambiguous_with": scored.ambiguous_with, "telling_sensor": scored.telling_sensor,
             "delta_bic": scored.delta_bic, "gap": effect.point.fit.gap,
             "delta_chi_square_halves": list(scored.halves) if scored.halves else None,
-            "confirmed_on_both_halves": bool(scored.halves and max(scored.halves) < 0.0)}
+            "confirmed_on_both_halves": bool(scored.halves and max(scored.halves) < 0.0),
+            "delta_chi_square_perturbed": list(scored.perturbed)} | (_verdict_of(effect, d) if d is not None else {})
+
+
+def _verdict_of(effect: Effect, d: Diagnosis) -> dict:
+    return {"significant_on_both_halves": significant_on_both_halves(effect.scored, d.record),
+            "robust_to_perturbations": robust_to_perturbations(effect.scored, d.record),
+            "explained_share": explained_share(effect, d.record),
+            "confirmed": confirmed(effect, d.check, d.record)}
+
+
+def _remaining(d: Diagnosis) -> dict:
+    """What remains after the effects found: the test against the noise, where, and what would help."""
+    test = d.check.test
+    return {"gap": d.after.gap, "gaps_settled": test.gaps, "effective_samples": test.effective_samples,
+            "p_values": test.p_values, "level": test.level, "beyond_noise": test.failing,
+            "windows": [{"sensor": w.sensor, "start_s": w.start, "end_s": w.end, "peak_noise_levels": w.peak}
+                        for w in d.check.windows],
+            "helpful_sensors": d.check.helpful_sensors}
 
 
 def _joint(joint: JointFit | None) -> dict | None:
@@ -74,7 +95,8 @@ def diagnosis_document(d: Diagnosis) -> dict:
     """The machine-readable diagnosis; `effects`, `gap_before`, `gap_after` and `gaps` are its stable core."""
     return {
         "config": str(d.request.config), "measured": str(d.request.measured), "overrides": list(d.request.overrides),
-        "effects": [_effect(s) for s in d.effects],
+        "effects": [_effect(e, d) for e in d.effects],
+        "unexplained": d.check.unexplained, "remaining": _remaining(d),
         "gap_before": d.before.gap, "gap_after": d.after.gap,
         "gaps": {s: {"before": d.before.gaps[s], "after": d.after.gaps[s]} for s in d.sensors},
         "trigger_offset_s": {"before": d.before.offset, "after": d.after.offset},
@@ -130,10 +152,43 @@ def _plain(value):
 
 
 def verdict(d: Diagnosis) -> str:
+    """One line: the effects (confirmed: "missing effect"; else "not confirmed"), and "unexplained" when what remains
+    of the record is not noise."""
+    named = "; ".join(f"{'missing effect' if confirmed(e, d.check, d.record) else 'not confirmed'}: {effect_line(e)}"
+                      for e in d.effects)
     if not d.effects:
-        return (f"no missing effect found: no candidate lowers the BIC by more than the significance margin; "
-                f"gap {d.before.gap:.3g}")
-    return "; ".join(f"missing effect: {effect_line(e)}" for e in d.effects)
+        named = (f"no missing effect found: no candidate lowers the BIC by more than the significance margin; "
+                 f"gap {d.before.gap:.3g}")
+    return f"{unexplained_line(d)}; {named}" if d.check.unexplained else named
+
+
+def unexplained_line(d: Diagnosis) -> str:
+    """'unexplained: the record stays 3.5 noise levels from the model …, beyond the noise on x (…); it disagrees most
+    at …; sensors that would tell more: …'."""
+    test, check = d.check.test, d.check
+    failing = ", ".join(f"{s} (gap {test.gaps[s]:.3g}, n_eff {test.effective_samples[s]:.0f}, p {test.p_values[s]:.2g})"
+                        for s in test.failing)
+    windows = ", ".join(f"{w.sensor} {w.start * 1e3:.3g}–{w.end * 1e3:.3g} ms ({w.peak:.1f}σ̂)" for w in check.windows[:3])
+    helpful = ", ".join(check.helpful_sensors) or "none among the model's sensors (add one near those windows)"
+    model = "the model with the effects found" if d.effects else "the model"
+    return (f"unexplained: the record stays {d.after.gap:.3g} noise levels from {model}, beyond the noise on {failing} "
+            f"(F test at {test.level:g}); it disagrees most at {windows or 'no 1-ms window above 3σ̂'}; "
+            f"sensors that would tell more: {helpful}")
+
+
+def _remaining_lines(d: Diagnosis) -> list[str]:
+    """What remains after the effects, against the noise: per sensor the gap without the comparison filter's start-up,
+    the residual's n_eff and p; then the verdict in words."""
+    test = d.check.test
+    out = [f"## What remains: {'unexplained' if d.check.unexplained else 'noise'}", "",
+           f"F test of each sensor's residual against the noise at {test.level:g} (shared among the sensors): "
+           "gap² against F(n_eff, ν), n_eff from the residual's autocorrelation, ν the degrees of freedom of σ̂ "
+           "(docs/diagnose.md §5).", "", "| sensor | gap | n_eff | p | beyond the noise |", "|---|---|---|---|---|"]
+    out += [f"| {s} | {test.gaps[s]:.3g} | {test.effective_samples[s]:.0f} | {test.p_values[s]:.2g} | "
+            f"{'yes' if s in test.failing else 'no'} |" for s in test.gaps]
+    if d.check.unexplained:
+        out += ["", unexplained_line(d) + "."]
+    return out + [""]
 
 
 def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
@@ -148,7 +203,8 @@ def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
         out.append(f"| {s} | {n.std:.3g} ({low:.3g}–{high:.3g}) {d.units.get(s, '')} | {NOISE_SOURCES[n.estimator]} | "
                    f"{n.effective_samples:.0f} / {n.samples} | {d.before.gaps[s]:.3g} | {d.after.gaps[s]:.3g} |")
     out += [f"| combined | | | | {d.before.gap:.3g} | {d.after.gap:.3g} |", "",
-            f"Trigger offset: {d.before.offset * 1e3:.3f} ms (fitted as a nuisance).", "", *_joint_lines(d),
+            f"Trigger offset: {d.before.offset * 1e3:.3f} ms (fitted as a nuisance).", "", *_remaining_lines(d),
+            *_joint_lines(d),
             "## Where the model and the record disagree (before)", "",
             "| sensor | feature | measured | model | unit |", "|---|---|---|---|---|"]
     out += [f"| {f.sensor} | {f.name} | {f.measured:.4g} | {f.model:.4g} | {f.unit} |" for f in d.iterations[0].features]

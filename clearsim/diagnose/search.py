@@ -62,6 +62,7 @@ ROUGH_POINTS = 8  # new values per round, evenly spread inside the window
 REFIT_ROUNDS = 3
 REFIT_STEP = 0.04  # first stencil step of the joint refit, in unit coordinates (4 % of each range)
 REFIT_REACH = 2.0  # the quadratic's minimum is looked for within 2 steps of the best point
+PERTURBATIONS = 3  # re-rolled impact sequences (candidates.perturbed) in which a found effect must still beat the model
 
 
 @dataclass
@@ -101,6 +102,7 @@ class Scored:
     windows: dict[bool, tuple[float, float]] = field(default_factory=dict)  # rough: per band (low_band?), centre
     # and half-width (unit range) of its window
     profiles: dict[bool, tuple[float, float]] = field(default_factory=dict)  # rough: per band, smoothed vertex, error
+    perturbed: list[float] = field(default_factory=list)  # Δχ² over the model of its estimate, impacts re-rolled
 
     @property
     def smoothed_in_low_band(self) -> bool:
@@ -477,6 +479,22 @@ def halves_improved(record: Record, baseline: Point, effect: Point) -> tuple[flo
 
     (base_first, base_second), (first, second) = halves(baseline), halves(effect)
     return first - base_first, second - base_second
+
+
+def bic_margin(effective_samples: float) -> float:
+    """Δχ² a one-parameter effect must beat the model by to lower the BIC by SIGNIFICANCE: ln n_eff + SIGNIFICANCE."""
+    return float(np.log(max(effective_samples, 2.0)) + SIGNIFICANCE)
+
+
+def significant_on_both_halves(scored: Scored, record: Record) -> bool:
+    """The effect lowers χ² on each half of the record by the BIC margin of that half (n_eff / 2)."""
+    return scored.halves is not None and max(scored.halves) < -bic_margin(record.effective_samples / 2.0)
+
+
+def robust_to_perturbations(scored: Scored, record: Record) -> bool:
+    """In each of PERTURBATIONS re-rolled impact sequences the effect still beats the model by the BIC margin: its
+    evidence is not one lucky realisation of a chaotic sequence."""
+    return len(scored.perturbed) >= PERTURBATIONS and max(scored.perturbed) < -bic_margin(record.effective_samples)
 
 
 def telling_sensor(first: Prediction, others: list[Prediction], scale: dict[str, float]) -> str | None:

@@ -58,6 +58,7 @@ def test_a_hidden_clearance_is_named_fitted_and_closes_the_gap(hidden_clearance)
         assert effect["parameters"]["clearance"] == pytest.approx(0.2e-3, rel=0.3)
     assert found["gap_after"] < 0.6 * found["gap_before"]
     assert abs(found["trigger_offset_s"]["before"] - 0.1e-3) < 0.05e-3
+    assert found["unexplained"] is False and effect["confirmed"]  # the record, with it, is down to the noise
 
 
 def test_the_report_and_the_augmented_model(hidden_clearance):
@@ -89,6 +90,7 @@ def test_noise_alone_finds_no_effect(tmp_path):
     record = synthesize(tmp_path / "bench.csv", seed=11)
     found = diagnose(record, tmp_path / "report", "--candidates", "clearance,drive")
     assert found["effects"] == []
+    assert found["unexplained"] is False
     assert found["gap_before"] == pytest.approx(1.0, abs=0.35)
     assert all(row["delta_bic"] is None or row["delta_bic"] > -10 for row in found["iterations"][0]["ranking"])
 

@@ -313,6 +313,6 @@ def perturbed(mechanism, document: dict, seed: int) -> dict:
     for joint in _clearance_joints(mechanism):
         angle = rng.uniform(0.0, 2.0 * np.pi)
         x, y = joint.initial_eccentricity or (0.0, 0.0)
-        moved = (x + PERTURBATION * np.cos(angle), y + PERTURBATION * np.sin(angle))
+        moved = (float(x + PERTURBATION * np.cos(angle)), float(y + PERTURBATION * np.sin(angle)))
         _set(changed, f"joints.{joint.name}.initial_eccentricity", f"[{moved[0]!r} m, {moved[1]!r} m]")
     return changed

@@ -77,3 +77,17 @@ def test_the_effective_samples_of_a_residual_follow_its_correlation():
     smooth = np.convolve(white, np.ones(20) / 20, mode="same")  # correlated over 20 samples: Σρ² ≈ 20·(2/3)
     assert residual_effective_samples(smooth) == pytest.approx(4000 / (1 + 2 * sum((1 - k / 20) ** 2 for k in range(1, 20))),
                                                                rel=0.2)
+
+
+def test_a_perturbed_copy_starts_each_clearance_journal_a_nanometre_off():
+    from clearsim.diagnose.candidates import PERTURBATION, perturbed
+    from clearsim.diagnose.evaluate import document_text
+    from clearsim.model.loader import load_mechanism, load_mechanism_text
+
+    loaded = load_mechanism(SLIDER_CRANK)
+    document = yaml.safe_load(loaded.resolved_yaml)
+    copies = [load_mechanism_text(document_text(perturbed(loaded.mechanism, document, seed)), str(SLIDER_CRANK), (),
+                                  SLIDER_CRANK.parent).mechanism for seed in (1, 2)]
+    starts = [np.array(next(j for j in m.joints if j.name == "slider_pin").initial_eccentricity) for m in copies]
+    assert all(np.linalg.norm(start) == pytest.approx(PERTURBATION) for start in starts)
+    assert np.linalg.norm(starts[0] - starts[1]) > 0.1 * PERTURBATION  # another seed, another direction

@@ -436,6 +436,7 @@ def diagnose(
     workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes (default: all cores)."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Run the simulations on a Dask cluster: tcp://host:8786."),
     fit_top: int = typer.Option(3, "--fit-top", help="Candidates fitted in full per iteration (the best of the screening)."),
+    ensemble: int = typer.Option(1, "--ensemble", help="Runs per candidate value with a rattling joint (perturbed by 1 nm): its cost is their median."),
 ) -> None:
     """Compare a model with measured data, name the missing effect, add it and show the gap shrink."""
     from clearsim.diagnose.report import verdict, write_report
@@ -443,7 +444,7 @@ def diagnose(
     from clearsim.runner import BUNDLED_CONFIG
 
     request = DiagnoseRequest(config or BUNDLED_CONFIG, measured[0], overrides, mapping, candidates, max_effects, out,
-                              workers, scheduler, lowpass, fit_top, measured[1:])
+                              workers, scheduler, lowpass, fit_top, measured[1:], ensemble)
     progress, beat, update = _diagnosis_progress()
     with progress, beat:
         result = run_diagnosis(request, say=lambda text: console.print(text, highlight=False, soft_wrap=True),

@@ -177,6 +177,41 @@ class Tracked:
         return self.evaluator.evaluate(documents, counted)
 
 
+class Ensembled:
+    """A Tracked evaluator that scores every document over an ensemble of copies no bench could tell apart
+    (`copies(document)`: the document and its perturbed twins, candidates.perturbed): each document's result is
+    the member with the median χ² (comparison band), so a value's cost is not one realisation of a chaotic impact
+    sequence — a lucky run among them is outvoted. Results that are no Points (a bare prediction) are the first
+    member's. Everything else (stage, progress, simulations) is the Tracked evaluator's."""
+
+    def __init__(self, tracked: Tracked, copies: Callable[[dict], list[dict]]):
+        self.tracked, self.copies = tracked, copies
+
+    def __getattr__(self, name):
+        return getattr(self.tracked, name)
+
+    def evaluate(self, documents: list[dict], then: Callable, labels: list[str]) -> list:
+        groups = [self.copies(d) for d in documents]
+        owner = [i for i, group in enumerate(groups) for _ in group]
+        members = self.tracked.evaluate([c for group in groups for c in group],
+                                        lambda k, prediction: then(owner[k], prediction),
+                                        [f"{labels[i]} ({n + 1} of {len(g)})" for i, g in enumerate(groups)
+                                         for n in range(len(g))])
+        results, start = [], 0
+        for group in groups:
+            results.append(median_member(members[start:start + len(group)]))
+            start += len(group)
+        return results
+
+
+def median_member(members: list):
+    """The member with the median χ² (the lower middle one of an even count); a failed run counts as the worst."""
+    if not all(isinstance(m, Point) for m in members):
+        return members[0]
+    ranked = sorted(members, key=lambda p: p.chi_square)
+    return ranked[(len(ranked) - 1) // 2]
+
+
 AS_GIVEN = "the model as given"
 
 

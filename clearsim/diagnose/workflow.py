@@ -25,12 +25,13 @@ from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for, pertu
 from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
 from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
-from clearsim.diagnose.search import (AS_GIVEN, PERTURBATIONS, SIGNIFICANCE, JointFit, Point, Scored, SearchProgress,
+from clearsim.diagnose.search import (AS_GIVEN, PERTURBATIONS, SIGNIFICANCE, Ensembled, JointFit, Point, Scored, SearchProgress,
                                      Tracked, aligned_residuals, halves_improved, judge, low_band_best, mark_ties,
                                      refine, refit_jointly, robust_to_perturbations, score_point, screen,
                                      seen_by_sensors, setting, significant_on_both_halves, to_fit)
 from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.model.loader import load_mechanism, load_mechanism_text
+from clearsim.model.resolve import is_clearance_joint
 from clearsim.units import UnitError, to_si
 
 RESULTS = Path("results")
@@ -58,6 +59,7 @@ class DiagnoseRequest:
     lowpass: str | None = None  # the bench's filter if known
     fit_top: int = FIT_TOP
     repeats: list[Path] = field(default_factory=list)  # further records of the same test: the noise from their spread
+    ensemble: int = 1  # runs per candidate value (the given one and perturbed twins): its cost is their median
 
 
 @dataclass
@@ -93,6 +95,7 @@ def found_effect(scored: Scored, before: Fit) -> Effect:
 
 HELPFUL_SENSORS = 2  # model sensors named as the ones to add to the bench
 SENSED = 1e-4  # of a sensor's range: an effect that changes it by less (RMS) leaves it as it is
+ENSEMBLE_SEED = 100  # the ensemble's twins are seeded 101, 102, …: other draws than the robustness check's 1, 2, 3
 MOST = 0.5  # of the excess χ² over n_eff: the share a confirmed effect explains while the record stays unexplained
 
 
@@ -222,6 +225,8 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
     started = clock.perf_counter()
     if request.max_effects < 1:
         raise DiagnoseError(f"--max-effects must be at least 1, got {request.max_effects}")
+    if request.ensemble < 1:
+        raise DiagnoseError(f"--ensemble must be at least 1 (runs per candidate value), got {request.ensemble}")
     if request.fit_top < 1:
         raise DiagnoseError(f"--fit-top must be at least 1 (the candidates fitted in full per iteration), "
                             f"got {request.fit_top}")
@@ -251,6 +256,8 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
     executor = _executor(request)
     evaluator = Tracked(Evaluator(folder / "runs", str(request.config), Path(request.config).parent, executor,
                                   record.rate), progress)
+    if request.ensemble > 1:
+        evaluator = Ensembled(evaluator, lambda document: ensemble_copies(document, request))
     iterations: list[Iteration] = []
     joint = None
     try:
@@ -426,6 +433,15 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
+
+
+def ensemble_copies(document: dict, request: DiagnoseRequest) -> list[dict]:
+    """The document and its request.ensemble − 1 perturbed twins (seeds 101, 102, …); without a clearance joint, nothing
+    chaotic to re-roll: the document alone."""
+    mechanism = _mechanism(document, request)
+    if not any(is_clearance_joint(j) for j in mechanism.joints):
+        return [document]
+    return [document] + [perturbed(mechanism, document, ENSEMBLE_SEED + seed) for seed in range(1, request.ensemble)]
 
 
 def perturbed_changes(evaluator, record: Record, sensors: list[str], document: dict, winner: Scored, baseline: Point,

@@ -159,6 +159,7 @@ def test_bad_measured_data_is_one_message_and_exit_code_2(tmp_path, problem, con
     (["--max-effects", "0"], "--max-effects"),
     (["--lowpass", "2 kg"], "--lowpass"),
     (["--fit-top", "0"], "--fit-top must be at least 1 (the candidates fitted in full per iteration), got 0"),
+    (["--ensemble", "0"], "--ensemble must be at least 1 (runs per candidate value), got 0"),
     (["--candidates", ",,"], "--candidates ',,': names no kind of effect; give some of clearance,"),
     (["--lowpass", "10Hz"], "--lowpass '10Hz': below 2 cycles over the record (5.98 ms), the comparison would keep no "
      "independent samples; give at least 334 Hz"),

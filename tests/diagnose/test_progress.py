@@ -9,7 +9,8 @@ from typer.testing import CliRunner
 
 from clearsim.cli import app
 from clearsim.diagnose.evaluate import Evaluator
-from clearsim.diagnose.search import Tracked
+from clearsim.diagnose.align import Fit
+from clearsim.diagnose.search import Ensembled, Point, Tracked
 from clearsim.diagnose.workflow import DiagnoseRequest, diagnose
 from tests.diagnose.test_evaluate import ReversedExecutor, documents
 
@@ -62,3 +63,24 @@ def test_a_diagnosis_reports_every_run_it_plans_and_its_best_model(tmp_path, mon
                key=lambda p: p.fit.gap)
     assert np.isclose(final.best_gap, min(best.fit.gap, result.before.gap))
     assert final.best_label.startswith("mass of ")
+
+
+def test_an_ensemble_scores_each_document_by_its_median_member_and_counts_every_run():
+    """Three copies per document: a lucky copy (χ² 1) among typical ones (10, 11) is outvoted; the progress counts
+    every copy as a run planned and done."""
+    chi = {("a", 0): 10.0, ("a", 1): 1.0, ("a", 2): 11.0, ("b", 0): 5.0, ("b", 1): 7.0, ("b", 2): 6.0}
+    states = []
+
+    class Runs:
+        simulations = 0
+
+        def evaluate(self, documents, then):
+            return [then(i, d) for i, d in enumerate(documents)]
+
+    tracked = Tracked(Runs(), lambda state: states.append(replace(state)))
+    ensemble = Ensembled(tracked, lambda document: [(document, k) for k in range(3)])
+    points = ensemble.evaluate(["a", "b"], lambda i, copy: Point(copy, Fit(0.0, chi[copy], {}, chi[copy]), None),
+                               ["a", "b"])
+    assert [p.chi_square for p in points] == [10.0, 6.0]
+    assert (states[-1].planned, states[-1].done) == (6, 6)
+    assert ensemble.simulations == 0 and ensemble.progress is tracked.progress

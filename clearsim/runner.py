@@ -129,12 +129,13 @@ def _final_attributes(run: Run, warnings: list[str]) -> dict:
 
 
 def _mode_attributes(system: System, loaded: LoadedMechanism, run: Run, whirls: dict) -> dict:
-    """`flexible_modes`: the flexible links' axial modes and what they are near (clearsim.model.modes), when the file
-    has flexible links."""
-    links = flexible_link_names(loaded.document, "axial")
-    if not links:
+    """`flexible_modes`: the flexible links' axial and bending modes and what they are near (clearsim.model.modes),
+    when the file has flexible links."""
+    links, beams = (flexible_link_names(loaded.document, model) for model in ("axial", "beam"))
+    if not links and not beams:
         return {}
-    return {"flexible_modes": flexible_modes_attribute(system, links, loaded.base_dir, run.episode_log(), whirls)}
+    return {"flexible_modes": flexible_modes_attribute(system, links, loaded.base_dir, run.episode_log(), whirls,
+                                                       beams)}
 
 
 def _travel_attributes(system: System, writer: ResultWriter) -> dict:

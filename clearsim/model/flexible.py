@@ -94,9 +94,13 @@ def joint_lists(mechanism) -> tuple[dict[str, list], set[str]]:
 
 
 def two_joint_links(mechanism) -> list[tuple[str, list]]:
-    """Bodies with exactly two revolute joints, in no prismatic joint and driven by no body driver."""
+    """Bodies with exactly two revolute joints, in no prismatic joint, driven by no body driver and at no end of a
+    rotational spring: two-force members (a rotational spring loads its bodies with a moment, as the bending
+    springs between the segments of a beam link do, so a segment is no two-force member)."""
     revolute, excluded = joint_lists(mechanism)
-    return [(name, joints) for name, joints in revolute.items() if len(joints) == 2 and name not in excluded]
+    bending = {name for force in mechanism.forces if isinstance(force, RotationalSpring) for name in force.bodies}
+    return [(name, joints) for name, joints in revolute.items()
+            if len(joints) == 2 and name not in excluded and name not in bending]
 
 
 def _joint_location(mechanism, poses, joint, body: str) -> np.ndarray:
@@ -354,12 +358,19 @@ def beam_layout(mechanism, poses, body: str) -> BeamLayout | None:
     return BeamLayout(body, ends[0], axis / length, length, flexibility.segments)
 
 
-def density_along_axis(mass: float, inertia: float, first: float, last: float) -> np.ndarray:
-    """(a, b, c) of the density ρ(u) = a + b u + c u² (kg/m) on u ∈ [first, last] (u: arc length from the centre
-    of mass's projection) whose mass is m, centre of mass u = 0 and inertia about it ∫ ρ u² du = J."""
+def density_along_axis(mass: float, inertia: float, first: float, last: float) -> tuple[np.ndarray, float]:
+    """((a, b, c), M) of the mass along the axis, u ∈ [first, last] (u: arc length from the centre of mass's
+    projection), whose mass is m, centre of mass u = 0 and inertia about it ∫ ρ u² du = J: the density
+    ρ(u) = a + b u + c u² (kg/m) and M = 0 when that density is positive; otherwise (J below what a positive
+    quadratic density gives: a link whose mass sits in a hub) the density a + b u and a concentrated mass M at u = 0."""
     moments = [(last ** (k + 1) - first ** (k + 1)) / (k + 1) for k in range(5)]
     system = np.array([[moments[i + j] for j in range(3)] for i in range(3)])
-    return np.linalg.solve(system, np.array([mass, 0.0, inertia]))
+    quadratic = np.linalg.solve(system, np.array([mass, 0.0, inertia]))
+    if lowest_density(quadratic, first, last) > 0.0:
+        return quadratic, 0.0
+    with_hub = np.array([[moments[0], moments[1], 1.0], [moments[1], moments[2], 0.0], [moments[2], moments[3], 0.0]])
+    a, b, hub = np.linalg.solve(with_hub, np.array([mass, 0.0, inertia]))
+    return np.array([a, b, 0.0]), float(hub)
 
 
 def lowest_density(coefficients: np.ndarray, first: float, last: float) -> float:
@@ -369,13 +380,16 @@ def lowest_density(coefficients: np.ndarray, first: float, last: float) -> float
     return min(a + b * u + c * u * u for u in candidates)
 
 
-def segment_moments(coefficients: np.ndarray, edges: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(masses, centres u, inertias about their centres) of the density between consecutive `edges` (u)."""
+def segment_moments(coefficients: np.ndarray, edges: np.ndarray, hub: float = 0.0
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(masses, centres u, inertias about their centres) of the density between consecutive `edges` (u), with the
+    concentrated mass `hub` at u = 0 in the segment that holds it."""
     def integral(power: int) -> np.ndarray:
         return sum(c * (edges[1:] ** (j + power + 1) - edges[:-1] ** (j + power + 1)) / (j + power + 1)
                    for j, c in enumerate(coefficients))
 
-    masses = integral(0)
+    holding = (edges[:-1] <= 0.0) & (0.0 < edges[1:])
+    masses = integral(0) + hub * holding
     centres = integral(1) / masses
     return masses, centres, integral(2) - masses * centres ** 2
 
@@ -410,10 +424,10 @@ def beam_segments(mechanism, poses, layout: BeamLayout) -> BeamSegments | None:
     body = mechanism.body(layout.body)
     centre = np.asarray(body.position, float)
     along = layout.arc_length(centre)
-    coefficients = density_along_axis(body.mass, body.inertia, -along, layout.length - along)
-    if lowest_density(coefficients, -along, layout.length - along) <= 0.0:
+    coefficients, hub = density_along_axis(body.mass, body.inertia, -along, layout.length - along)
+    if lowest_density(coefficients, -along, layout.length - along) < 0.0 or hub < 0.0:
         return None
-    masses, centres, inertias = segment_moments(coefficients, layout.edges - along)
+    masses, centres, inertias = segment_moments(coefficients, layout.edges - along, hub)
     joints = [a.location for a in attachments(mechanism, poses, layout.body) if a.section == "joints"]
     named = layout.segment_of(joints[0] if joints else centre)
     names = [layout.body if k == named else f"{layout.body}_s{k + 1}" for k in range(layout.elements + 1)]

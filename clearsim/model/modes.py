@@ -1,5 +1,5 @@
-"""Which axial modes of the flexible links lie near the contact frequencies (docs/model.md §9, "Modes near the
-contacts").
+"""Which modes of the flexible links lie near the contact frequencies (docs/model.md §9, "Modes near the
+contacts", and §10).
 
 Axial mode of a flexible link: f = √(k / m_eff) / 2π, k its `<body>_compliance` stiffness and 1/m_eff the mobility
 of its slide `<body>_stretch`: the stretch acceleration s̈ = gᵀ A g per unit pair of opposite forces along the link
@@ -7,6 +7,11 @@ of its slide `<body>_stretch`: the stretch acceleration s̈ = gᵀ A g per unit 
 with every clearance joint closed (an ideal pin) and every other flexible link's slide held. With the link's spring
 the only stiffness this is the exact linear mode at t = 0; for the free link m_eff = m/4, for a link fixed at one end
 carrying a mass M at the other m_eff = M + m/2.
+
+Bending mode of a beam link: the model at t = 0 with every clearance joint closed, linearised (M_r = Tᵀ M T,
+K_r = Tᵀ ∇²V T, T an orthonormal basis of the null space of Φ_q, V the compiled potential energy; the constraint
+forces' geometric stiffness left out); a mode belongs to the beam link whose bending springs store the largest
+share of its strain energy, when that share is above one half; the link's lowest such mode is reported.
 
 Contact frequency of a clearance joint: 1/(2 t_c), t_c the Hertz contact duration of its contact episodes at their
 own impact speed and effective mass (their 5th–95th percentile range), or of an impact at 1 m/s with the reduced
@@ -99,6 +104,56 @@ def axial_mode_frequencies(mechanism, links: list[str], base_dir) -> dict[str, f
     return frequencies
 
 
+def linear_modes(system) -> tuple[np.ndarray, np.ndarray]:
+    """(frequencies in Hz, mode shapes as columns of q) of the assembled system linearised at q0, at rest (module
+    docstring); the Hessian of V by central differences, exact for the springs' quadratic energy."""
+    import scipy.linalg
+
+    from clearsim.assembly.arrays import for_kernels, mass_diagonal
+    from clearsim.assembly.constraints import dense_jacobian
+    from clearsim.assembly.forces import potential_energy
+
+    arrays = for_kernels(system.arrays)
+    basis = scipy.linalg.null_space(dense_jacobian(arrays, system.q0))
+    if not basis.shape[1]:
+        return np.zeros(0), np.zeros((system.q0.size, 0))
+    step = HESSIAN_STEP * np.eye(basis.shape[1])
+
+    def energy(x):
+        return potential_energy(arrays, system.q0 + basis @ x)
+
+    stiffness = np.array([[(energy(a + b) - energy(a - b) - energy(b - a) + energy(-a - b)) / (4 * HESSIAN_STEP ** 2)
+                           for b in step] for a in step])
+    mass = basis.T @ np.diag(mass_diagonal(system.arrays)) @ basis
+    eigenvalues, shapes = scipy.linalg.eigh(stiffness, mass)
+    return np.sqrt(np.abs(eigenvalues)) / (2 * math.pi), basis @ shapes
+
+
+HESSIAN_STEP = 1e-5  # of the null-space coordinates (m, rad): small against the links, large against round-off
+
+
+def bending_energies(system, link: str, shapes: np.ndarray) -> np.ndarray:
+    """½ Σ k_θ (δθ_j − δθ_i)² of the link's bending springs `<link>_bend<k>`, per mode shape (column)."""
+    energy = np.zeros(shapes.shape[1])
+    for force in system.mechanism.forces:
+        if force.name.startswith(f"{link}_bend") and force.name[len(link) + 5:].isdigit():
+            first, second = (3 * system.body_names.index(body) + 2 for body in force.bodies)
+            energy += 0.5 * force.stiffness * (shapes[second] - shapes[first]) ** 2
+    return energy
+
+
+def bending_mode_frequencies(mechanism, links: list[str], base_dir) -> dict[str, float]:
+    """Each beam link's lowest bending mode (Hz), as the module's docstring defines it; NaN when no mode is its."""
+    from clearsim.assembly.system import assemble
+
+    system = assemble(_closed_clearances(mechanism), base_dir)
+    frequencies, shapes = linear_modes(system)
+    total = 0.5 * (2 * math.pi * frequencies) ** 2  # the strain energy of each mass-normalised shape, ½ ω²
+    shares = {link: bending_energies(system, link, shapes) / np.maximum(total, np.finfo(float).tiny)
+              for link in links}
+    return {link: float(min(frequencies[share > 0.5], default=math.nan)) for link, share in shares.items()}
+
+
 def contact_frequencies(system, episodes) -> list[tuple[float, float]]:
     """Per clearance joint, the range of 1/(2 t_c) over its contact episodes (CONTACT_PERCENTILES), or at the
     reference impact when it had none (Hz)."""
@@ -116,9 +171,10 @@ def contact_frequencies(system, episodes) -> list[tuple[float, float]]:
     return ranges
 
 
-def mode_report(modes: dict[str, float], joints: list[JointFrequencies]) -> list[dict]:
-    """The `flexible_modes` attribute (as a list): per link its mode and what it is near."""
-    return [{"link": link, "axial_mode_hz": mode,
+def mode_report(modes: dict[str, float], joints: list[JointFrequencies], kind: str = "axial") -> list[dict]:
+    """The `flexible_modes` attribute (as a list): per link its `kind` ("axial" or "bending") mode and what it is
+    near."""
+    return [{"link": link, f"{kind}_mode_hz": mode,
              "near_contacts": [j.joint for j in joints if near(mode, *j.contacts)],
              "near_whirls": [j.joint for j in joints if any(near(mode, w, w) for w in j.whirls)],
              "contacts_hz": {j.joint: list(j.contacts) for j in joints},
@@ -126,20 +182,29 @@ def mode_report(modes: dict[str, float], joints: list[JointFrequencies]) -> list
             for link, mode in modes.items()]
 
 
-def flexible_modes_attribute(system, links: list[str], base_dir, episodes, whirls: dict) -> str:
+def flexible_modes_attribute(system, links: list[str], base_dir, episodes, whirls: dict,
+                             beams: list[str] = ()) -> str:
     """The result file's `flexible_modes` (JSON, mode_report) of a run's system, its episode log and its joints'
-    whirls (clearsim.whirl.joint_whirls); a mode is NaN when the model with closed clearance joints does not
-    assemble."""
+    whirls (clearsim.whirl.joint_whirls): the axial links' axial modes, then the beam links' lowest bending modes; a
+    mode is NaN when the model with closed clearance joints does not assemble."""
+    joints = [JointFrequencies(joint, contacts, tuple(whirl.frequency for whirl in whirls.get(joint, ())))
+              for joint, contacts in zip(system.clearance_joints, contact_frequencies(system, episodes))]
+    report = []
+    for kind, names, frequencies in (("axial", list(links), axial_mode_frequencies),
+                                     ("bending", list(beams), bending_mode_frequencies)):
+        if names:
+            report += mode_report(_modes_or_nan(frequencies, system.mechanism, names, base_dir), joints, kind)
+    return json.dumps(report)
+
+
+def _modes_or_nan(frequencies, mechanism, links: list[str], base_dir) -> dict[str, float]:
     from clearsim.assembly.build import BuildError
     from clearsim.errors import ClearsimError
 
     try:
-        modes = axial_mode_frequencies(system.mechanism, links, base_dir)
+        return frequencies(mechanism, links, base_dir)
     except (BuildError, ClearsimError, ValueError, np.linalg.LinAlgError):
-        modes = dict.fromkeys(links, math.nan)
-    joints = [JointFrequencies(joint, contacts, tuple(whirl.frequency for whirl in whirls.get(joint, ())))
-              for joint, contacts in zip(system.clearance_joints, contact_frequencies(system, episodes))]
-    return json.dumps(mode_report(modes, joints))
+        return dict.fromkeys(links, math.nan)
 
 
 def frequency_text(frequency: float) -> str:
@@ -157,7 +222,7 @@ def range_text(lowest: float, highest: float) -> str:
 
 def mode_lines(attribute: str) -> list[str]:
     """One line per flexible link from the `flexible_modes` attribute, e.g. "flexible link pole: axial mode 412 Hz,
-    near nothing (within √2); joint J: contacts 6–8 kHz, whirl 2.1 kHz"."""
+    near nothing (within √2); joint J: contacts 6–8 kHz, whirl 2.1 kHz" ("bending mode" for a beam link)."""
     lines = []
     for entry in json.loads(attribute) if attribute else []:
         nearby = [f"joint {j}'s contacts" for j in entry["near_contacts"]]
@@ -167,7 +232,8 @@ def mode_lines(attribute: str) -> list[str]:
             whirls = entry["whirls_hz"].get(joint, [])
             joints.append(f"joint {joint}: contacts {range_text(*contacts)}"
                           + "".join(f", whirl {frequency_text(w)}" for w in whirls))
-        head = (f"flexible link {entry['link']}: axial mode {frequency_text(entry['axial_mode_hz'])}, near "
+        kind = "axial" if "axial_mode_hz" in entry else "bending"
+        head = (f"flexible link {entry['link']}: {kind} mode {frequency_text(entry[f'{kind}_mode_hz'])}, near "
                 f"{' and '.join(nearby) if nearby else 'no contact or whirl frequency'} (within ×√2)")
         lines.append("; ".join([head] + joints))
     return lines

@@ -43,6 +43,7 @@ CASES = [
     Case("uhv-c0.1", UHV, ("joints.A.clearance=0.1mm", "joints.J.clearance=0.1mm"), ("solver.t_end=10ms",)),
     Case("uhv-flex-ideal", UHV_FLEXIBLE, ("joints.A.clearance=0", "joints.J.clearance=0")),
     Case("uhv-flex-c0.01", UHV_FLEXIBLE, (), ("solver.t_end=10ms",)),
+    Case("uhv-flex-c0.1", UHV_FLEXIBLE, ("joints.A.clearance=0.1mm", "joints.J.clearance=0.1mm"), ("solver.t_end=10ms",)),
     *[Case(f"uhv-{law}", UHV, (f"defaults.contact.elastic={law}", "defaults.contact.length=50mm",
                                "defaults.contact.stiffness=auto"), ("solver.t_end=10ms",))
       for law in ("johnson", "pereira", "liu")],  # one per elastic-law family: implicit line, power fit, conformal

@@ -8,10 +8,11 @@ with every clearance joint closed (an ideal pin) and every other flexible link's
 the only stiffness this is the exact linear mode at t = 0; for the free link m_eff = m/4, for a link fixed at one end
 carrying a mass M at the other m_eff = M + m/2.
 
-Bending mode of a beam link: the model at t = 0 with every clearance joint closed, linearised (M_r = Tᵀ M T,
-K_r = Tᵀ ∇²V T, T an orthonormal basis of the null space of Φ_q, V the compiled potential energy; the constraint
-forces' geometric stiffness left out); a mode belongs to the beam link whose bending springs store the largest
-share of its strain energy, when that share is above one half; the link's lowest such mode is reported.
+Bending mode of a beam link (and, in a model with beam links, the axial mode of an axial link): the model at t = 0
+with every clearance joint closed, linearised (M_r = Tᵀ M T, K_r = Tᵀ ∇²V T, T an orthonormal basis of the null
+space of Φ_q, V the compiled potential energy; the constraint forces' geometric stiffness left out); a mode belongs
+to the flexible link whose springs (bending springs, or axial spring) store the largest share of its strain
+energy; the link's lowest such mode is reported.
 
 Contact frequency of a clearance joint: 1/(2 t_c), t_c the Hertz contact duration of its contact episodes at their
 own impact speed and effective mass (their 5th–95th percentile range), or of an impact at 1 m/s with the reduced
@@ -132,26 +133,31 @@ def linear_modes(system) -> tuple[np.ndarray, np.ndarray]:
 HESSIAN_STEP = 1e-5  # of the null-space coordinates (m, rad): small against the links, large against round-off
 
 
-def bending_energies(system, link: str, shapes: np.ndarray) -> np.ndarray:
-    """½ Σ k_θ (δθ_j − δθ_i)² of the link's bending springs `<link>_bend<k>`, per mode shape (column)."""
+def strain_energies(system, link: str, shapes: np.ndarray) -> np.ndarray:
+    """Per mode shape (column), the energy in the link's springs: ½ Σ k_θ (δθ_j − δθ_i)² of its bending springs
+    `<link>_bend<k>`, ½ k (gᵀ δq)² of its axial spring `<link>_compliance`."""
     energy = np.zeros(shapes.shape[1])
     for force in system.mechanism.forces:
         if force.name.startswith(f"{link}_bend") and force.name[len(link) + 5:].isdigit():
             first, second = (3 * system.body_names.index(body) + 2 for body in force.bodies)
             energy += 0.5 * force.stiffness * (shapes[second] - shapes[first]) ** 2
+        elif force.name == f"{link}_compliance":
+            energy += 0.5 * force.stiffness * (_stretch_row(system.body_names, system.q0, force) @ shapes) ** 2
     return energy
 
 
-def bending_mode_frequencies(mechanism, links: list[str], base_dir) -> dict[str, float]:
-    """Each beam link's lowest bending mode (Hz), as the module's docstring defines it; NaN when no mode is its."""
+def linearised_mode_frequencies(mechanism, links: list[str], base_dir) -> dict[str, float]:
+    """Each flexible link's lowest mode of the linearised model (Hz): the lowest mode whose strain energy its
+    springs hold the largest share of, among `links` (module docstring); NaN when no mode is its."""
     from clearsim.assembly.system import assemble
 
     system = assemble(_closed_clearances(mechanism), base_dir)
     frequencies, shapes = linear_modes(system)
     total = 0.5 * (2 * math.pi * frequencies) ** 2  # the strain energy of each mass-normalised shape, ½ ω²
-    shares = {link: bending_energies(system, link, shapes) / np.maximum(total, np.finfo(float).tiny)
-              for link in links}
-    return {link: float(min(frequencies[share > 0.5], default=math.nan)) for link, share in shares.items()}
+    shares = np.array([strain_energies(system, link, shapes) / np.maximum(total, np.finfo(float).tiny)
+                       for link in links]).reshape(len(links), -1)
+    owner = np.argmax(shares, axis=0)
+    return {link: float(min(frequencies[owner == k], default=math.nan)) for k, link in enumerate(links)}
 
 
 def contact_frequencies(system, episodes) -> list[tuple[float, float]]:
@@ -189,11 +195,12 @@ def flexible_modes_attribute(system, links: list[str], base_dir, episodes, whirl
     mode is NaN when the model with closed clearance joints does not assemble."""
     joints = [JointFrequencies(joint, contacts, tuple(whirl.frequency for whirl in whirls.get(joint, ())))
               for joint, contacts in zip(system.clearance_joints, contact_frequencies(system, episodes))]
-    report = []
-    for kind, names, frequencies in (("axial", list(links), axial_mode_frequencies),
-                                     ("bending", list(beams), bending_mode_frequencies)):
-        if names:
-            report += mode_report(_modes_or_nan(frequencies, system.mechanism, names, base_dir), joints, kind)
+    if beams:  # the mobility of a slide with the other slides held would leave the beams' hinges free pins
+        modes = _modes_or_nan(linearised_mode_frequencies, system.mechanism, [*links, *beams], base_dir)
+        axial, bending = {link: modes[link] for link in links}, {link: modes[link] for link in beams}
+    else:
+        axial, bending = _modes_or_nan(axial_mode_frequencies, system.mechanism, list(links), base_dir), {}
+    report = mode_report(axial, joints, "axial") + mode_report(bending, joints, "bending")
     return json.dumps(report)
 
 

@@ -17,6 +17,7 @@ AXIAL_LINKS = ("lower_linkage", "lower_linking_board", "insulating_pole", "upper
 BEAM_LINKS = ("lower_turn_arm", "main_crank_arm")
 FLEXIBLE_LINKS = AXIAL_LINKS + BEAM_LINKS
 SEGMENTS = 3  # the file's beam segments: n = 3 elements, n + 1 segments
+POLE_MODE_AXIAL_CHAIN = 85.7  # Hz: the pole's axial mode in the chain with rigid crank arms (docs/validation.md §7)
 IDEAL = ("joints.A.clearance=0", "joints.J.clearance=0")
 MID_STROKE = 42.5e-3  # s: half the 85 ms stroke
 
@@ -121,5 +122,7 @@ def test_the_summary_gives_each_crank_arms_lowest_bending_mode(runs_at_10_microm
     bending = {entry["link"]: entry["bending_mode_hz"] for entry in json.loads(attribute) if "bending_mode_hz" in entry}
     assert set(bending) == set(BEAM_LINKS)
     assert all(50.0 < mode < 5e3 for mode in bending.values())  # a steel crank arm in the chain: 10² Hz to kHz
+    pole = next(entry["axial_mode_hz"] for entry in json.loads(attribute) if entry["link"] == "insulating_pole")
+    assert pole < POLE_MODE_AXIAL_CHAIN  # the arms' bending compliance can only lower it (Rayleigh)
     assert {f"flexible link {link}: bending mode" for link in BEAM_LINKS} <= \
            {line.split(" mode ")[0] + " mode" for line in mode_lines(attribute)}

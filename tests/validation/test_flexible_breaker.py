@@ -1,8 +1,8 @@
 """The breaker with flexible links (configs/uhv_breaker_flexible.yaml): the bundled breaker with its pole a GFRP
 tube and its two-joint steel links stretching, its two crank arms steel beams. Its links keep the rigid file's mass,
 centre of mass and inertia, its ideal stroke is the rigid one's within 1 %, its energy balance closes, its beam
-segments are no two-force members, the summary gives the crank arms' bending modes, and J still whirls at 0.01 mm,
-shorter than in the rigid chain."""
+segments are no two-force members, the summary gives the crank arms' bending modes, and J whirls less at 0.01 mm
+than in the rigid chain."""
 
 from pathlib import Path
 
@@ -107,10 +107,12 @@ def whirl_orbits(warnings: list[str]) -> int:
     return sum(int(match.group(1)) for match in found if match)
 
 
-def test_j_whirls_in_the_rigid_chain_and_shorter_with_the_bending_crank_arms(runs_at_10_micrometres):
+def test_j_whirls_in_the_rigid_chain_and_less_with_flexible_links(runs_at_10_micrometres):
+    """Whether J still whirls with flexible links depends on the arms' discretisation (54 orbits at n = 3, none at
+    n = 4, 24 at n = 6: docs/validation.md §7); fewer orbits than the rigid chain's in each."""
     rigid, flexible = (whirl_orbits(runs_at_10_micrometres[config][0]) for config in (RIGID, FLEXIBLE))
     assert rigid > 0  # the rigid chain's journal runs round its bore at J
-    assert 0 < flexible < rigid  # with the crank arms bending it still does, for fewer orbits
+    assert flexible < rigid
 
 
 def test_the_summary_gives_each_crank_arms_lowest_bending_mode(runs_at_10_micrometres):

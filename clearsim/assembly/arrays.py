@@ -74,6 +74,7 @@ SystemArrays = namedtuple(
         "clearance_bodies", "clearance_laws", "clearance_params",
         "load_bodies", "load_params", "load_law",
         "spring_bodies", "spring_params",
+        "driveline_kinds", "driveline_bodies", "driveline_params", "driveline_table",  # assembly/drivelines.py
         "hydraulic_bodies", "hydraulic_params", "hydraulic_laws",
         "torsion_bodies", "torsion_params",
     ],

@@ -66,6 +66,8 @@ FIELD_LAYOUT = {
     "clearance_bodies": ("i8", 2), "clearance_laws": ("i8", 2), "clearance_params": ("f8", 2),
     "load_bodies": ("i8", 1), "load_params": ("f8", 2), "load_law": ("i8", 1),
     "spring_bodies": ("i8", 2), "spring_params": ("f8", 2),
+    "driveline_kinds": ("i8", 2), "driveline_bodies": ("i8", 2), "driveline_params": ("f8", 2),
+    "driveline_table": ("f8", 2),
     "hydraulic_bodies": ("i8", 2), "hydraulic_params": ("f8", 2), "hydraulic_laws": ("i8", 2),
     "torsion_bodies": ("i8", 2), "torsion_params": ("f8", 2),
     "inverse_mass": ("f8", 1), "solve_blocks": ("f8", 3), "solve_bodies": ("i8", 2), "solve_schur": ("f8", 2),

@@ -75,8 +75,8 @@ SystemArrays = namedtuple(
         "load_bodies", "load_params", "load_law",
         "spring_bodies", "spring_params",
         "driveline_kinds", "driveline_bodies", "driveline_params", "driveline_table",  # assembly/drivelines.py
-        "hydraulic_bodies", "hydraulic_params", "hydraulic_laws",
         "torsion_bodies", "torsion_params",
+        "hydraulic_bodies", "hydraulic_params", "hydraulic_laws",
     ],
     # force elements with states (assembly/hydraulics.py): none unless given
     defaults=(np.zeros((0, 2), np.int64), np.zeros((0, HYDRAULIC_COLUMNS)), np.zeros((0, HYDRAULIC_LAW_COLUMNS), np.int64)),

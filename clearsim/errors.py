@@ -146,10 +146,12 @@ class InputError(ClearsimError):
 class SolverError(ClearsimError):
     """The integration could not go on; says when, in which element, and what to try."""
 
-    def __init__(self, message: str, time: float, element: str | None = None, hint: str | None = None):
+    def __init__(self, message: str, time: float, element: str | None = None, hint: str | None = None,
+                 kind: str = "joint"):
         self.message = message
         self.time = time
         self.element = element
+        self.kind = kind  # what the element is: joint, force
         self.hint = hint
         self.place: str | None = None  # "file:line:column  joints[k] 'name'" of the element, when known
         super().__init__(str(self))
@@ -157,7 +159,7 @@ class SolverError(ClearsimError):
     def __str__(self) -> str:
         where = f"at t = {self.time * 1e3:.4g} ms"
         if self.element:
-            where += f", joint {self.element}"
+            where += f", {self.kind} {self.element}"
         text = f"{where}: {self.message.rstrip('.')}."
         text = f"{self.place}: {text}" if self.place else text
         return f"{text} {self.hint}" if self.hint else text

@@ -34,7 +34,7 @@ from clearsim.model.modes import flexible_modes_attribute, mode_lines
 from clearsim.physics.cylindrical import range_warnings
 from clearsim.physics.lubrication import film_range_warnings
 from clearsim.solver.outputs import (
-    classify_episodes, chunk_outputs, full_precision, output_rate, sample_modes, stored_outputs,
+    classify_episodes, chunk_outputs, driveline_dissipations, full_precision, output_rate, sample_modes, stored_outputs,
 )
 from clearsim.solver.samples import C_ECC_X, C_ECC_Y
 from clearsim.solver.simulate import Chunk, Run, Statistics
@@ -249,11 +249,11 @@ def _give_its_name(writer: ResultWriter, output: Path, readable: bool, error: Ex
 
 
 def element_place(loaded: LoadedMechanism, element: str | None) -> str:
-    """Where the joint or driver a solver failure names is in the mechanism file: "file:line:column  joints[k] 'J'";
+    """Where the joint, driver or force a solver failure names is in the mechanism file: "file:line:column  joints[k] 'J'";
     a failure that names neither is placed at the file's `solver:` settings, whose limits stopped the run."""
     name = (element or "").split(" (")[0]
     path = next((path for path, item in loaded.source.names.items()
-                 if len(path) == 2 and path[0] in ("joints", "drivers") and item == name), ("solver",))
+                 if len(path) == 2 and path[0] in ("joints", "drivers", "forces") and item == name), ("solver",))
     position = loaded.source.locate(path)[0]
     at = f"{loaded.path}:{position[0]}:{position[1]}" if position else str(loaded.path)
     return f"{at}  {format_path(path, loaded.source.names)}"
@@ -272,7 +272,8 @@ def result_file_bytes(system: System, contents: str = "all") -> float:
         "joints/j/eccentricity": 5 * clearances, "joints/j/sliding_velocity": 3 * clearances,
         "drivers/d/effort": len(system.drivers),
         "sensors/s": len(system.sensors),
-        "energy/e": 9,
+        "forces/f/force": 2 * len(system.arrays.driveline_kinds),
+        "energy/e": 9 + len(driveline_dissipations(system)),
     }
     per_sample = sum(count * (8 if full_precision(name) else 4) for name, count in values.items()
                      if name == "time" or CONTENTS[contents](name))

@@ -74,8 +74,9 @@ SystemArrays = namedtuple(
         "clearance_bodies", "clearance_laws", "clearance_params",
         "load_bodies", "load_params", "load_law",
         "spring_bodies", "spring_params",
-        "hydraulic_bodies", "hydraulic_params", "hydraulic_laws",
+        "driveline_kinds", "driveline_bodies", "driveline_params", "driveline_table",  # assembly/drivelines.py
         "torsion_bodies", "torsion_params",
+        "hydraulic_bodies", "hydraulic_params", "hydraulic_laws",
     ],
     # force elements with states (assembly/hydraulics.py): none unless given
     defaults=(np.zeros((0, 2), np.int64), np.zeros((0, HYDRAULIC_COLUMNS)), np.zeros((0, HYDRAULIC_LAW_COLUMNS), np.int64)),

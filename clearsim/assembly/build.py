@@ -59,6 +59,9 @@ class Poses:
         r, angle = self.pose(body)
         return _rotation(angle).T @ (np.asarray(global_point, float) - r)
 
+    def direction_to_body_frame(self, body: int, direction) -> np.ndarray:
+        return _rotation(self.pose(body)[1]).T @ np.asarray(direction, float)
+
     def to_global(self, body: int, body_point) -> np.ndarray:
         r, angle = self.pose(body)
         return r + _rotation(angle) @ np.asarray(body_point, float)
@@ -102,6 +105,22 @@ def joint_points(poses: Poses, joint, path) -> tuple[int, int, np.ndarray, np.nd
         return bi, bj, si, sj
     location = poses.point_global(joint.at, bi, path + ("at",))
     return bi, bj, poses.to_body_frame(bi, location), poses.to_body_frame(bj, location)
+
+
+def force_ends(poses: Poses, force, path) -> tuple[int, int, np.ndarray, np.ndarray, float]:
+    """(body i, body j, point i and point j in their body frames, length between them at t = 0) of a two-ended
+    force (`bodies:` with `at:` or `points:`; by default the centres of mass)."""
+    if force.points is not None:
+        si, bi = poses.named_body_point(force.bodies[0], force.points[0], path + ("points", 0))
+        sj, bj = poses.named_body_point(force.bodies[1], force.points[1], path + ("points", 1))
+        pi, pj = poses.to_global(bi, si), poses.to_global(bj, sj)
+    else:
+        bi, bj = poses.index[force.bodies[0]], poses.index[force.bodies[1]]
+        ends = force.at if force.at is not None else (None, None)
+        pi = poses.point_global(ends[0], bi, path + ("at", 0))
+        pj = poses.point_global(ends[1], bj, path + ("at", 1))
+        si, sj = poses.to_body_frame(bi, pi), poses.to_body_frame(bj, pj)
+    return bi, bj, si, sj, float(np.linalg.norm(pj - pi))
 
 
 def perpendicular(vector) -> np.ndarray:
@@ -235,8 +254,9 @@ def _float_array(values, columns) -> np.ndarray:
 
 
 def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: list, springs: list,
-         torsions: list, cylinders: list = ()) -> SystemArrays:
-    """The arrays the kernels read, from the named lists (cylinders: system._cylinders')."""
+         torsions: list, drivelines: dict, cylinders: list = ()) -> SystemArrays:
+    """The arrays the kernels read, from the named lists (drivelines: the driveline_* arrays; cylinders:
+    system._cylinders')."""
     breaks, coefficients, first, count = motion.concatenate(laws.items)
     return SystemArrays(
         mass=np.array([b.mass for b in mechanism.bodies], float),
@@ -262,6 +282,7 @@ def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: l
         load_law=_int_array([ld[2] for ld in loads]),
         spring_bodies=_int_array([s[0] for s in springs], 2),
         spring_params=_float_array([s[1] for s in springs], SPRING_COLUMNS),
+        **drivelines,
         hydraulic_bodies=_int_array([c[1] for c in cylinders], 2),
         hydraulic_params=_float_array([c[2] for c in cylinders], HYDRAULIC_COLUMNS),
         hydraulic_laws=_int_array([c[3] for c in cylinders], HYDRAULIC_LAW_COLUMNS),

@@ -24,6 +24,7 @@ from clearsim.assembly.constraints import (
 from clearsim.assembly.forces import (
     STICK, add_applied_forces, add_clearance_forces, add_global_force, clearance_kinematics, stick_row,
 )
+from clearsim.assembly.drivelines import add_driveline_forces, driveline_powers
 from clearsim.assembly.hydraulics import add_hydraulic_forces, hydraulic_rates
 from clearsim.assembly.kinematics import point_position
 from clearsim.assembly.arrays import CL_BEARING_POINT, copy_into
@@ -37,7 +38,9 @@ WORK_SUPPLY = 5  # energy the hydraulic supplies delivered, ∫ p_s Q_s dt
 WORK_TANK = 6  # energy the oil carried into the tanks, ∫ p_T Q_T dt
 WORK_ORIFICE = 7  # dissipated in the orifices, ∫ Σ Q Δp dt
 WORK_OIL = 8  # stored in the oil's compression, ∫ Σ p (Q_in − V̇) dt
-WORK_COUNT = 9
+WORK_DASHPOT = 9  # dissipated in the dashpots (assembly/drivelines.py)
+WORK_GUIDE_FRICTION = 10  # dissipated by the guide frictions
+WORK_COUNT = 11
 
 # factor_key[0]: what the scratch holds (factored_jacobian)
 FACTOR_NONE, FACTOR_SPD, FACTOR_SINGULAR = 0, 1, 2
@@ -243,6 +246,7 @@ def generalized_forces(system, t, q, qd, modes, impact_speeds):
     generalized = np.zeros(q.shape[0])
     applied, damping = add_applied_forces(system, t, q, qd, generalized)
     contact, friction = add_clearance_forces(system, q, qd, modes, impact_speeds, generalized)
+    add_driveline_forces(system, t, q, qd, generalized)  # their powers: driveline_powers, in rhs
     return generalized, applied, damping, contact, friction
 
 
@@ -284,12 +288,15 @@ def rhs(system, dynamics, t, y, modes, impact_speeds, ydot):
     ydot[2 * n + WORK_CONTACT] = contact
     ydot[2 * n + WORK_FRICTION] = friction
     ydot[2 * n + WORK_DAMPING] = damping
-    ydot[2 * n + WORK_APPLIED] = applied
+    dashpot, guide_friction, latch = driveline_powers(system, t, q, qd)
+    ydot[2 * n + WORK_APPLIED] = applied + latch
     supply, tank, orifice, oil = hydraulic_rates(system, t, q, qd, z, element_states(system, ydot))
     ydot[2 * n + WORK_SUPPLY] = supply
     ydot[2 * n + WORK_TANK] = tank
     ydot[2 * n + WORK_ORIFICE] = orifice
     ydot[2 * n + WORK_OIL] = oil
+    ydot[2 * n + WORK_DASHPOT] = dashpot
+    ydot[2 * n + WORK_GUIDE_FRICTION] = guide_friction
 
 
 @njit(cache=True)

@@ -23,10 +23,11 @@ from clearsim.assembly.arrays import (
     CL_V_HIGH, CL_V_LOW, CL_DRY_GAP, CL_FILM_LENGTH, CL_VISCOSITY, LAW_FILM_MODEL,
 )
 from clearsim.assembly.kinematics import (
-    GROUND, add_point_force, body_frame, body_pose, body_rates, frame_point, frame_rotate, frame_velocity,
-    line_kinematics, point_position, point_velocity,
+    GROUND, add_global_force, add_point_force, body_frame, body_pose, body_rates, frame_point, frame_rotate,
+    frame_velocity, line_kinematics, point_position, point_velocity,
 )
 from clearsim.assembly.constraints import prescribed
+from clearsim.assembly.drivelines import driveline_potential
 from clearsim.physics.contact import damped_force
 from clearsim.physics.cylindrical import law_state
 from clearsim.physics.friction import STICK_EXACT, friction_coefficient, sliding_coefficient
@@ -39,17 +40,6 @@ FREE = 0
 CONTACT = 1
 STICK = 2
 SLIDE_BACK = 3
-
-
-@njit(cache=True)
-def add_global_force(generalized, q, body, px, py, fx, fy):
-    """Add a global force (fx, fy) applied at the global point (px, py) of a body."""
-    if body == GROUND:
-        return
-    x, y, _ = body_pose(q, body)
-    generalized[3 * body] += fx
-    generalized[3 * body + 1] += fy
-    generalized[3 * body + 2] += (px - x) * fy - (py - y) * fx
 
 
 @njit(cache=True)
@@ -260,7 +250,7 @@ def spring_state(system, k, q, qd):
 @njit(cache=True)
 def potential_energy(system, q):
     """Gravity + spring and rotational spring (elastic and preload) + contact elastic energy ∫₀^δ F_el
-    (K δⁿ⁺¹/(n+1) for the power laws)."""
+    (K δⁿ⁺¹/(n+1) for the power laws) + spring drives and gas loads."""
     energy = 0.0
     for b in range(system.mass.shape[0]):
         energy -= system.mass[b] * (system.gravity[0] * q[3 * b] + system.gravity[1] * q[3 * b + 1])
@@ -280,4 +270,4 @@ def potential_energy(system, q):
         p = system.clearance_params[k]
         energy += law_state(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT],
                             p[CL_CLEARANCE])[2]
-    return energy
+    return energy + driveline_potential(system, q)

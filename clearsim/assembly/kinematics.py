@@ -96,3 +96,14 @@ def line_kinematics(q, qd, bi, bj, sxi, syi, sxj, syj):
     length = max(np.sqrt((xj - xi) ** 2 + (yj - yi) ** 2), 1e-300)
     ux, uy = (xj - xi) / length, (yj - yi) / length
     return length, ux * (vjx - vix) + uy * (vjy - viy), ux, uy
+
+
+@njit(cache=True)
+def add_global_force(generalized, q, body, px, py, fx, fy):
+    """Add a global force (fx, fy) applied at the global point (px, py) of a body."""
+    if body == GROUND:
+        return
+    x, y, _ = body_pose(q, body)
+    generalized[3 * body] += fx
+    generalized[3 * body + 1] += fy
+    generalized[3 * body + 2] += (px - x) * fy - (py - y) * fx

@@ -17,6 +17,7 @@ from clearsim.assembly import build, hydraulics
 from clearsim.assembly.arrays import KernelArrays, SystemArrays, for_kernels, mass_diagonal
 from clearsim.assembly.build import BuildError, ConstraintRows, Laws, Poses
 from clearsim.assembly.constraints import constraint_count, dense_jacobian, evaluate_constraints, evaluate_velocity_rhs
+from clearsim.assembly.drivelines import driveline_arrays
 from clearsim.errors import Problem
 from clearsim.model import schema
 from clearsim.physics import motion
@@ -66,7 +67,7 @@ def _loads(mechanism, poses: Poses, laws: Laws, base_dir: Path) -> list:
     loads = []
     for index, force in enumerate(mechanism.forces):
         path = ("forces", index)
-        if isinstance(force, schema.TWO_BODY):
+        if not isinstance(force, (schema.ConstantForce, schema.TabulatedForce)):
             continue
         body = poses.index[force.body]
         point = poses.to_body_frame(body, poses.point_global(force.point, body, path + ("point",)))
@@ -83,28 +84,12 @@ def _loads(mechanism, poses: Poses, laws: Laws, base_dir: Path) -> list:
     return loads
 
 
-def _ends(poses: Poses, force, path) -> tuple[int, int, np.ndarray, np.ndarray, float]:
-    """(body i, body j, point i and point j in their body frames, length between them at t = 0) of a two-ended
-    force (`bodies:` with `at:` or `points:`)."""
-    if force.points is not None:
-        si, bi = poses.named_body_point(force.bodies[0], force.points[0], path + ("points", 0))
-        sj, bj = poses.named_body_point(force.bodies[1], force.points[1], path + ("points", 1))
-        pi, pj = poses.to_global(bi, si), poses.to_global(bj, sj)
-    else:
-        bi, bj = poses.index[force.bodies[0]], poses.index[force.bodies[1]]
-        ends = force.at if force.at is not None else (None, None)
-        pi = poses.point_global(ends[0], bi, path + ("at", 0))
-        pj = poses.point_global(ends[1], bj, path + ("at", 1))
-        si, sj = poses.to_body_frame(bi, pi), poses.to_body_frame(bj, pj)
-    return bi, bj, si, sj, float(np.linalg.norm(pj - pi))
-
-
 def _springs(mechanism, poses: Poses) -> list:
     springs = []
     for index, force in enumerate(mechanism.forces):
         if not isinstance(force, schema.SpringDamper):
             continue
-        bi, bj, si, sj, length = _ends(poses, force, ("forces", index))
+        bi, bj, si, sj, length = build.force_ends(poses, force, ("forces", index))
         free = force.free_length if force.free_length is not None else length
         springs.append(((bi, bj), [*si, *sj, force.stiffness, force.damping, free, force.preload]))
     return springs
@@ -117,7 +102,7 @@ def _cylinders(mechanism, poses: Poses, laws: Laws) -> list:
         if not isinstance(force, schema.HydraulicCylinder):
             continue
         path = ("forces", index)
-        bi, bj, si, sj, length = _ends(poses, force, path)
+        bi, bj, si, sj, length = build.force_ends(poses, force, path)
         problems = hydraulics.build_problems(force, length, mechanism.solver.t_end, path)
         if problems:
             raise BuildError(problems)
@@ -255,7 +240,7 @@ def assemble(mechanism: schema.Mechanism, base_dir: Path | str = ".") -> System:
     loads = _loads(mechanism, poses, laws, base_dir)
     cylinders = _cylinders(mechanism, poses, laws)
     arrays = build.pack(mechanism, rows, clearances, laws, loads, _springs(mechanism, poses),
-                        _torsions(mechanism, poses), cylinders)
+                        _torsions(mechanism, poses), driveline_arrays(mechanism, poses, base_dir), cylinders)
     owners = rows.row_owners()
     assembly_arrays = _pinned_clearances(arrays, clearances)
     assembly_owners = owners[: 2 * len(rows.pins)] + [c[-1] for c in clearances for _ in range(2)] + owners[2 * len(rows.pins):]

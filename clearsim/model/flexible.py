@@ -117,8 +117,8 @@ def _force_ends(poses, force, body: str) -> list[tuple[int, np.ndarray]]:
     index = poses.index[body]
     if isinstance(force, RotationalSpring):
         return []
-    if not isinstance(force, TWO_ENDED):
-        return [(0, poses.point_global(force.point, index, ()))] if force.body == body else []
+    if not isinstance(force, TWO_ENDED):  # a guide friction acts on a joint: no end on a body
+        return [(0, poses.point_global(force.point, index, ()))] if getattr(force, "body", None) == body else []
     ends = []
     for end, name in enumerate(force.bodies):
         if name != body:

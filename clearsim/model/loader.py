@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 import stat
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
 from typing import Any, Sequence
@@ -363,16 +363,26 @@ def _references_of_valid_part(document: dict, exc: ValidationError) -> list[Prob
         return []
     partial = {key: value for key, value in document.items() if (key,) not in invalid}
     partial.update({key: value for key, value in _STAND_INS.items() if (key,) in invalid})
-    known = {}
+    known, kept = {}, {}
     for key in KINDS:
         items = partial.get(key)
         if isinstance(items, list):
-            partial[key] = [item for index, item in enumerate(items) if (key, index) not in invalid]
+            kept[key] = [index for index in range(len(items)) if (key, index) not in invalid]
+            partial[key] = [items[index] for index in kept[key]]
             known[key] = {_name(item) for index, item in enumerate(items) if (key, index) in invalid}
     try:
-        return check_references(Mechanism.model_validate(partial), known)
+        problems = check_references(Mechanism.model_validate(partial), known)
     except ValidationError:
         return []
+    return [_in_file_order(problem, kept) for problem in problems]
+
+
+def _in_file_order(problem: Problem, kept: dict[str, list[int]]) -> Problem:
+    """A problem of the valid part located at its item's index in the file (the part leaves invalid items out)."""
+    path = problem.path
+    if len(path) > 1 and path[0] in kept and isinstance(path[1], int):
+        return replace(problem, path=(path[0], kept[path[0]][path[1]]) + tuple(path[2:]))
+    return problem
 
 
 # --- loading --------------------------------------------------------------------------------------

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from clearsim.errors import Problem, did_you_mean
 from clearsim.model import schema
-from clearsim.model.resolve import ResolveError, is_clearance_joint, resolve_clearance
+from clearsim.model.resolve import ResolveError, guide_friction_numbers, is_clearance_joint, resolve_clearance
 
 GROUND = "ground"
 KINDS = {"bodies": "body", "joints": "joint", "drivers": "driver", "forces": "force", "sensors": "sensor"}
@@ -234,11 +234,12 @@ def _doubly_driven(mechanism: schema.Mechanism) -> list[Problem]:
 
 
 def _check_force(names: _Names, force, path: tuple) -> list[Problem]:
+    if isinstance(force, schema.GuideFriction):
+        return _check_guide_friction(names, force, path)
     if not isinstance(force, schema.TWO_BODY):
         return names.body(force.body, path + ("body",), ground_allowed=False) + names.global_point(
             force.point, path + ("point",))
-    kind = {schema.SpringDamper: "spring", schema.RotationalSpring: "rotational spring"}.get(type(force),
-                                                                                          "hydraulic cylinder")
+    kind = {schema.SpringDamper: "spring"}.get(type(force), force.type.replace("_", " "))
     problems = [p for k in (0, 1) for p in names.body(force.bodies[k], path + ("bodies", k))]
     if force.bodies[0] == force.bodies[1]:
         problems.append(Problem(path + ("bodies",), f"a {kind} connects two different bodies; both are "
@@ -252,6 +253,21 @@ def _check_force(names: _Names, force, path: tuple) -> list[Problem]:
         problems += [p for k in (0, 1) for p in names.body_point(force.bodies[k], force.points[k], path + ("points", k))]
     if force.at is not None:
         problems += [p for k in (0, 1) for p in names.global_point(force.at[k], path + ("at", k))]
+    return problems
+
+
+def _check_guide_friction(names: _Names, force: schema.GuideFriction, path: tuple) -> list[Problem]:
+    """The joint exists and is prismatic; the friction law resolves to numbers a smooth law integrates."""
+    problems = names.joint(force.joint, path + ("joint",))
+    joint = names.joints.get(force.joint)
+    if joint is not None and not isinstance(joint, schema.PrismaticJoint):
+        problems.append(Problem(path + ("joint",), f"joint '{force.joint}' is a {joint.type} joint; a guide friction "
+                                "acts on a prismatic joint", "name a prismatic joint: "
+                                + _listing(j.name for j in names.joints.values() if j.type == "prismatic")))
+    try:
+        guide_friction_numbers(force.friction)
+    except ResolveError as exc:
+        problems.append(Problem(path + ("friction",) + exc.path_suffix, exc.message, exc.hint))
     return problems
 
 

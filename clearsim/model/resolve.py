@@ -217,6 +217,23 @@ def _check_friction(friction: dict, origin: dict) -> None:
     _check_friction_order(friction, origin)
 
 
+def guide_friction_numbers(spec: FrictionSpec) -> dict:
+    """law, mu_s, mu_d, v_low, v_high of a guide friction (its own block, no layers); ResolveError (relative to the
+    block) when a parameter is missing or unused, or when the law would stick exactly."""
+    friction = {name: getattr(spec, name) for name in FrictionSpec.model_fields if getattr(spec, name) is not None}
+    if "law" not in friction:
+        raise ResolveError((), "a guide friction needs its friction `law`", "e.g. {law: ambrosio, mu_d: 0.15, "
+                           "v_0: 0, v_1: 1 mm/s} or {law: coulomb, mu_d: 0.15, stick: smooth}")
+    origin = {name: (False, ()) for name in friction}
+    _check_friction(friction, origin)
+    numbers = _friction_numbers(friction)
+    if numbers["stick"] == "exact":
+        raise _error_at(origin, "stick", f"a guide friction integrates its law as written: friction law "
+                        f"'{friction['law']}' with exact sticking is not available on a guide",
+                        "write `stick: smooth` (or use the ambrosio law)")
+    return {"law": friction["law"]} | {key: numbers[key] for key in ("mu_s", "mu_d", "v_low", "v_high")}
+
+
 def _on_joint(origin: dict, name: str) -> bool:
     where = origin.get(name)
     return where is not None and not where[0]

@@ -25,6 +25,7 @@ from clearsim.units import (
     Area,
     AngularSpeed,
     Damping,
+    Density,
     Force,
     Frequency,
     Inertia,
@@ -43,6 +44,7 @@ from clearsim.units import (
     UnitError,
     UnitSystem,
     Viscosity,
+    Volume,
     bare_number,
     bare_number_message,
     declared_system,
@@ -334,23 +336,35 @@ class Driver(Strict):
 # --- applied forces -------------------------------------------------------------------------------
 
 
-class ConstantForce(Strict):
-    type: Literal["constant"] = Field(description="force kind")
+class BodyPointForce(Strict):
+    """A force element acting at a point of one body."""
+
+    type: str = Field(description="force kind")
     name: str = Field(description="unique force name")
     body: str = Field(description="loaded body")
     point: PointRef | None = Field(None, description="point of application: global point at t = 0, fixed to the body; default centre of mass")
+
+
+class ConstantForce(BodyPointForce):
+    type: Literal["constant"] = Field(description="force kind")
     force: tuple[Force, Force] = Field((0.0, 0.0), description="[F_x, F_y], global frame")
     torque: Torque = Field(0.0, description="torque, counter-clockwise positive")
 
 
-class SpringDamper(Strict):
-    """Linear spring-damper between two points: F = k (ℓ − ℓ0) + c ℓ̇ + preload, along the line."""
+class TwoPointForce(Strict):
+    """A force element acting along the line between a point of each of two bodies."""
 
-    type: Literal["spring_damper"] = Field(description="force kind")
+    type: str = Field(description="force kind")
     name: str = Field(description="unique force name")
     bodies: tuple[str, str] = Field(description="the two connected bodies")
     at: tuple[PointRef, PointRef] | None = Field(None, description="the two ends as global points at t = 0; default the centres of mass")
     points: tuple[str, str] | None = Field(None, description="the two ends as named body points")
+
+
+class SpringDamper(TwoPointForce):
+    """Linear spring-damper between two points: F = k (ℓ − ℓ0) + c ℓ̇ + preload, along the line."""
+
+    type: Literal["spring_damper"] = Field(description="force kind")
     stiffness: SpringStiffness = Field(0.0, description="spring rate k")
     damping: Damping = Field(0.0, description="damping coefficient c")
     free_length: Length | None = Field(None, ge=0.0, description="ℓ0; default: the length at t = 0")
@@ -370,11 +384,8 @@ class RotationalSpring(Strict):
     preload: Torque = Field(0.0, description="constant torque added to the spring torque")
 
 
-class TabulatedForce(Strict):
+class TabulatedForce(BodyPointForce):
     type: Literal["tabulated"] = Field(description="force kind")
-    name: str = Field(description="unique force name")
-    body: str = Field(description="loaded body")
-    point: PointRef | None = Field(None, description="point of application: global point at t = 0, fixed to the body; default centre of mass")
     direction: Direction = Field(description="direction of the force, global frame, normalised")
     file: str = Field(description="CSV file, relative to the YAML file")
     time_column: Union[str, int] = Field(0, description="header name or 0-based index of the time column")
@@ -512,8 +523,156 @@ class HydraulicCylinder(Strict):
         return self
 
 
-AppliedForce = Annotated[Union[ConstantForce, SpringDamper, RotationalSpring, TabulatedForce, HydraulicCylinder], Field(discriminator="type")]
-TWO_ENDED = (SpringDamper, HydraulicCylinder)  # the forces between two bodies' points (`bodies:`, `at:`/`points:`)
+# --- drive-line elements (docs/model-drives.md): stateless forces of a stroke s ----------------------
+
+Sense = Literal["lengthening", "shortening"]
+SENSE_DESCRIPTION = ("which change of the distance between the two points is the positive stroke s: lengthening "
+                     "s = ℓ − ℓ0, shortening s = ℓ0 − ℓ (ℓ0: the distance at t = 0)")
+
+
+class _StrokeTable(Strict):
+    """A value against stroke, inline (`rows:`) or from a CSV file; linear between rows, held beyond the ends."""
+
+    file: str | None = Field(None, description="CSV file, relative to the YAML file (instead of rows)")
+    stroke_column: Union[str, int] = Field(0, description="header name or 0-based index of the stroke column")
+    value_column: Union[str, int] = Field(1, description="header name or 0-based index of the value column")
+    stroke_unit: str = Field("m", description="unit of the stroke column")
+
+    _units_alone = field_validator("stroke_unit", "value_unit", check_fields=False)(unit_name)
+
+    @model_validator(mode="after")
+    def _one_source(self):
+        if (self.rows is None) == (self.file is None):
+            raise ValueError("a stroke table takes either `rows:` or `file:`, not both or neither")
+        return self
+
+    @field_validator("rows", check_fields=False)
+    @classmethod
+    def _strokes_increase(cls, rows):
+        if rows is not None and any(b[0] <= a[0] for a, b in zip(rows, rows[1:])):
+            raise ValueError("the strokes of the rows must increase strictly")
+        return rows
+
+
+class ForceStrokeTable(_StrokeTable):
+    """A force against stroke, inline (`rows:`) or from a CSV file; linear between rows, held beyond the ends."""
+
+    rows: list[tuple[Length, Force]] | None = Field(None, min_length=2, description="[[stroke, force], ...], strokes increasing")
+    value_unit: str = Field("N", description="unit of the force column")
+
+
+class PressureStrokeTable(_StrokeTable):
+    """An absolute pressure against stroke, inline (`rows:`) or from a CSV file; linear between rows, held beyond
+    the ends."""
+
+    rows: list[tuple[Length, Pressure]] | None = Field(None, min_length=2, description="[[stroke, pressure], ...], strokes increasing")
+    value_unit: str = Field("Pa", description="unit of the pressure column (absolute, like p_ambient)")
+
+
+class SpringDrive(TwoPointForce):
+    """A charged operating spring, latched until `release_time`, then F(s) ≥ 0 drives the stroke s."""
+
+    type: Literal["spring_drive"] = Field(description="force kind")
+    sense: Sense = Field("lengthening", description=SENSE_DESCRIPTION + "; the spring drives s forward (default "
+                         "lengthening: a compression spring pushing the points apart)")
+    stiffness: SpringStiffness | None = Field(None, ge=0.0, description="linear spring: rate k, F = preload − k s")
+    preload: Force | None = Field(None, description="linear spring: force at t = 0 (s = 0)")
+    free_length: Length | None = Field(None, gt=0.0, description="linear spring: distance at which F = 0, instead of preload")
+    table: ForceStrokeTable | None = Field(None, description="tabulated spring: force against stroke, instead of stiffness")
+    release_time: Time = Field(0.0, ge=0.0, description="time at which the latch releases the spring (no force before)")
+
+    @model_validator(mode="after")
+    def _one_law(self):
+        linear = self.stiffness is not None
+        if linear == (self.table is not None):
+            raise ValueError("a spring drive takes either `stiffness:` (linear) or `table:`, not both or neither")
+        if linear and (self.preload is None) == (self.free_length is None):
+            raise ValueError("a linear spring drive takes either `preload:` or `free_length:`, not both or neither")
+        if not linear and (self.preload is not None or self.free_length is not None):
+            raise ValueError("a tabulated spring drive takes its forces from the table: remove preload and free_length")
+        return self
+
+
+class Dashpot(TwoPointForce):
+    """F = −c ṡ (linear) or −sgn(ṡ) ρ A_p³ ṡ²/(2 C_d² a²) (orifice), while the stroke s is in `engaged`."""
+
+    type: Literal["dashpot"] = Field(description="force kind")
+    sense: Sense = Field("shortening", description=SENSE_DESCRIPTION + "; default shortening (a dashpot compressed "
+                         "at the end of the stroke)")
+    damping: Damping | None = Field(None, ge=0.0, description="linear dashpot: coefficient c")
+    piston_area: Area | None = Field(None, gt=0.0, description="orifice dashpot: piston area A_p")
+    orifice_area: Area | None = Field(None, gt=0.0, description="orifice dashpot: orifice area a")
+    discharge_coefficient: float = Field(0.7, gt=0.0, le=1.0, description="orifice dashpot: discharge coefficient C_d")
+    density: Density | None = Field(None, gt=0.0, description="orifice dashpot: oil density ρ, e.g. 870 kg/m^3")
+    engaged: tuple[Length, Length] | None = Field(None, description="[start, end] of the stroke range in which the "
+                                                  "dashpot acts; default everywhere")
+    engagement_length: Length = Field(0.0, ge=0.0, description="length over which the force fades in after start and "
+                                      "out before end (smoothstep); 0: sharp edges")
+
+    @model_validator(mode="after")
+    def _one_law(self):
+        orifice = (self.piston_area, self.orifice_area, self.density)
+        if (self.damping is None) == all(v is None for v in orifice):
+            raise ValueError("a dashpot takes either `damping:` (linear) or piston_area, orifice_area and density "
+                             "(orifice), not both or neither")
+        if self.damping is None and any(v is None for v in orifice):
+            missing = [k for k, v in zip(("piston_area", "orifice_area", "density"), orifice) if v is None]
+            raise ValueError(f"an orifice dashpot needs {' and '.join(missing)}")
+        if self.engaged is not None and 2 * self.engagement_length > self.engaged[1] - self.engaged[0]:
+            raise ValueError("engagement_length is longer than half the engagement range")
+        return self
+
+    @field_validator("engaged")
+    @classmethod
+    def _range_in_order(cls, engaged: tuple[float, float] | None) -> tuple[float, float] | None:
+        if engaged is not None and engaged[1] <= engaged[0]:
+            raise ValueError(f"the engagement range [start, end] needs end > start, got [{engaged[0] * 1e3:g} mm, "
+                             f"{engaged[1] * 1e3:g} mm]: write the stroke at which the dashpot starts to act first")
+        return engaged
+
+
+class GasLoad(BodyPointForce):
+    """The gas force on a body point (of the moving contact) against its stroke s = d·(P − P(0)) along a fixed
+    global direction d."""
+
+    type: Literal["gas_load"] = Field(description="force kind")
+    direction: Direction = Field(description="global direction of the compressing stroke; the force acts against it")
+    force_table: ForceStrokeTable | None = Field(None, description="force against stroke (positive: resisting)")
+    pressure_table: PressureStrokeTable | None = Field(None, description="absolute pressure against stroke; F = (p − p_ambient) A")
+    area: Area | None = Field(None, gt=0.0, description="piston (puffer) area A of a pressure table or an adiabatic volume")
+    volume: Volume | None = Field(None, gt=0.0, description="adiabatic puffer: gas volume V0 at s = 0")
+    initial_pressure: Pressure | None = Field(None, gt=0.0, description="adiabatic puffer: absolute pressure p0 at s = 0; default p_ambient")
+    gamma: float | None = Field(None, ge=1.0, le=5.0 / 3.0, description="adiabatic puffer: heat capacity ratio γ (air 1.4, SF6 1.1; 1: isothermal)")
+    stroke: Length | None = Field(None, gt=0.0, description="adiabatic puffer: the largest stroke the motion reaches; A·stroke must stay below V0")
+    p_ambient: Pressure = Field(101325.0, ge=0.0, description="absolute pressure outside the puffer; default 101.325 kPa")
+
+    _unit_direction = field_validator("direction")(_unit_vector)
+
+    @model_validator(mode="after")
+    def _one_law(self):
+        laws = [self.force_table is not None, self.pressure_table is not None, self.volume is not None]
+        if sum(laws) != 1:
+            raise ValueError("a gas load takes one of force_table, pressure_table or volume (adiabatic puffer)")
+        if (self.pressure_table is not None or self.volume is not None) and self.area is None:
+            raise ValueError("a pressure table or a puffer volume needs the piston `area`")
+        if self.volume is not None and (self.gamma is None or self.stroke is None):
+            raise ValueError("an adiabatic puffer needs `gamma` and `stroke`")
+        return self
+
+
+class GuideFriction(Strict):
+    """Coulomb-type friction of a prismatic joint under a stated normal force, against the sliding speed."""
+
+    type: Literal["guide_friction"] = Field(description="force kind")
+    name: str = Field(description="unique force name")
+    joint: str = Field(description="prismatic joint whose sliding it resists")
+    normal_force: Force = Field(gt=0.0, description="normal force N pressing the sliding faces (e.g. the contact fingers' preload)")
+    friction: FrictionSpec = Field(description="friction law and parameters (a smooth law: `stick: smooth` or ambrosio)")
+
+
+AppliedForce = Annotated[Union[ConstantForce, SpringDamper, RotationalSpring, TabulatedForce, HydraulicCylinder,
+                               SpringDrive, Dashpot, GasLoad, GuideFriction], Field(discriminator="type")]
+TWO_ENDED = (TwoPointForce, HydraulicCylinder)  # the forces between two bodies' points (`bodies:`, `at:`/`points:`)
 TWO_BODY = TWO_ENDED + (RotationalSpring,)  # every force between two bodies (`bodies:`)
 
 

@@ -44,16 +44,18 @@ def _read_rows(path: Path) -> tuple[list[str], np.ndarray]:
 
 
 def read_table_column(path: Path, time_column, value_column, time_unit: str, value_unit: str,
-                      kind: str, where=None) -> tuple[np.ndarray, np.ndarray]:
-    """(times in s, values in SI of `kind`) from a CSV file; times must increase strictly."""
+                      kind: str, where=None, argument_kind: str = "time",
+                      argument_name: str = "time") -> tuple[np.ndarray, np.ndarray]:
+    """(arguments in SI of `argument_kind`, values in SI of `kind`) from a CSV file; the arguments (times, or
+    e.g. strokes) must increase strictly."""
     path = Path(path)
     header, data = _read_rows(path)
     if data.shape[0] < 2:
         raise ValueError(f"table '{path.name}' needs at least two rows")
-    times = data[:, _column_index(header, time_column, path)] * to_si(f"1 {time_unit}", "time")
+    times = data[:, _column_index(header, time_column, path)] * to_si(f"1 {time_unit}", argument_kind)
     values = data[:, _column_index(header, value_column, path)] * to_si(f"1 {value_unit}", kind)
     if not np.all(np.isfinite(times)) or not np.all(np.isfinite(values)):
         raise ValueError(f"table '{path.name}' contains NaN or infinite values")
     if np.any(np.diff(times) <= 0.0):
-        raise ValueError(f"the time column of '{path.name}' must increase strictly")
+        raise ValueError(f"the {argument_name} column of '{path.name}' must increase strictly")
     return times, values

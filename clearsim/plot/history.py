@@ -15,7 +15,7 @@ from clearsim.plot.style import (LEGEND_WIDTH, axes_or_new, legend_beside, new_f
 
 ENERGY_KINDS = ("kinetic", "potential", "driver_work", "applied_work", "contact_dissipated",
                 "friction_dissipated", "damping_dissipated", "hydraulic_supply_work", "hydraulic_tank_work",
-                "orifice_dissipated", "oil_compression")
+                "orifice_dissipated", "oil_compression", "dashpot_dissipated", "guide_friction_dissipated")
 VIOLATION_FLOOR = 1e-18  # m: stands for an exact zero on the logarithmic axis
 SPECTRUM_RANGE = 1e-8  # amplitudes below the highest peak × this are numerical floor (of an ideal run): not shown
 SPECTRUM_FLOOR_PERCENTILE = 1.0  # the amplitude axis starts at a third of this percentile of the clearance runs

@@ -20,9 +20,10 @@ import numpy as np
 from clearsim.assembly.arrays import CL_CLEARANCE, CL_EXPONENT, CL_MIN_IMPACT_SPEED, CL_STIFFNESS, OFF_DIRECTION
 from clearsim.assembly.forces import STICK
 from clearsim.assembly import hydraulics
+from clearsim.assembly.drivelines import DASHPOT, GUIDE_FRICTION, driveline_histories
 from clearsim.assembly.dynamics import (
-    WORK_APPLIED, WORK_CONTACT, WORK_COUNT, WORK_DAMPING, WORK_DRIVER, WORK_FRICTION, WORK_OIL, WORK_ORIFICE, WORK_SUPPLY,
-    WORK_TANK,
+    WORK_APPLIED, WORK_CONTACT, WORK_COUNT, WORK_DAMPING, WORK_DASHPOT, WORK_DRIVER, WORK_FRICTION, WORK_GUIDE_FRICTION,
+    WORK_OIL, WORK_ORIFICE, WORK_SUPPLY, WORK_TANK,
 )
 from clearsim.assembly.system import SensorSpec, System
 from clearsim.model import schema
@@ -192,6 +193,14 @@ def clearance_histories(system: System, chunk, modes: np.ndarray) -> dict:
     return out
 
 
+def driveline_dissipations(system: System) -> dict[str, int]:
+    """{energy name: WORK slot} of the dissipations of the driveline element kinds the model has (a model without
+    dashpots writes no `dashpot_dissipated`)."""
+    kinds = set(system.arrays.driveline_kinds[:, 0].tolist())
+    slots = {DASHPOT: ("dashpot_dissipated", WORK_DASHPOT), GUIDE_FRICTION: ("guide_friction_dissipated", WORK_GUIDE_FRICTION)}
+    return dict(slots[kind] for kind in sorted(kinds & slots.keys()))
+
+
 def energy_histories(system: System, chunk, initial_energy: float) -> dict:
     n = system.coordinate_count
     work = chunk.states[:, 2 * n:]
@@ -200,14 +209,15 @@ def energy_histories(system: System, chunk, initial_energy: float) -> dict:
         "contact_dissipated": work[:, WORK_CONTACT], "friction_dissipated": work[:, WORK_FRICTION],
         "damping_dissipated": work[:, WORK_DAMPING], "driver_work": work[:, WORK_DRIVER],
         "applied_work": work[:, WORK_APPLIED],
-    }
+    } | {name: work[:, slot] for name, slot in driveline_dissipations(system).items()}
     if system.hydraulic_cylinders:
         named |= {"hydraulic_supply_work": work[:, WORK_SUPPLY], "hydraulic_tank_work": work[:, WORK_TANK],
                   "orifice_dissipated": work[:, WORK_ORIFICE], "oil_compression": work[:, WORK_OIL]}
     named["balance_error"] = (chunk.kinetic + chunk.potential - initial_energy - work[:, WORK_DRIVER]
                               - work[:, WORK_APPLIED] + work[:, WORK_CONTACT] + work[:, WORK_FRICTION]
                               + work[:, WORK_DAMPING] - work[:, WORK_SUPPLY] + work[:, WORK_TANK]
-                              + work[:, WORK_ORIFICE] + work[:, WORK_OIL])
+                              + work[:, WORK_ORIFICE] + work[:, WORK_OIL] + work[:, WORK_DASHPOT]
+                              + work[:, WORK_GUIDE_FRICTION])
     return {f"energy/{key}": (value, "J") for key, value in named.items()}
 
 
@@ -287,6 +297,7 @@ def chunk_outputs(system: System, chunk, modes: np.ndarray, initial_energy: floa
     out |= hydraulics.drive_histories(system.hydraulic_cylinders, system.arrays.hydraulic_bodies,
                                       system.arrays.hydraulic_params, chunk.states[:, :n],
                                       chunk.states[:, 2 * n + WORK_COUNT:])
+    out |= driveline_histories(system, chunk.times, chunk.states)
     out["constraints/violation"] = (chunk.violation, "m")
     origins = sensor_origins(system)
     for spec in system.sensors:

@@ -16,6 +16,7 @@ import numpy as np
 
 from clearsim.assembly.arrays import CL_BEARING_RADIUS, CL_MU_D, CL_MU_S, CL_STIFFNESS, for_kernels
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints
+from clearsim.assembly.drivelines import puffer_overrun
 from clearsim.assembly.dynamics import WORK_COUNT
 from clearsim.assembly.forces import FREE
 from clearsim.assembly.system import System
@@ -401,6 +402,9 @@ class Run:
                           "the contact stiffness is far too low for the load (check `stiffness` and its unit, N/m^1.5), "
                           "or solver.rtol too loose to resolve the impact (try 1e-7)"),
         }
+        overrun = puffer_overrun(self.system, self.y[:self.coordinate_count])
+        if overrun is not None:
+            return SolverError(overrun[1], time=t, element=overrun[0], hint=overrun[2], kind="force")
         message, hint = messages[status]
         if status == ig.MIN_STEP and all(mode == FREE for mode in self.modes):
             # no contact is closed: the stiff or jumping force is elsewhere (found by the input fuzz: a mass of

@@ -8,6 +8,7 @@ from clearsim.assembly.arrays import (CLEARANCE_COLUMNS, LOAD_COLUMNS, SPRING_CO
 from clearsim.assembly.constraints import (
     constraint_count, dense_jacobian, evaluate_acceleration_rhs, evaluate_constraints, evaluate_velocity_rhs,
 )
+from clearsim.assembly.drivelines import DRIVELINE_COLUMNS
 from clearsim.physics import motion
 
 
@@ -28,6 +29,8 @@ def mixed_system() -> KernelArrays:
         load_bodies=np.zeros(0, np.int64), load_params=np.zeros((0, LOAD_COLUMNS)), load_law=np.zeros(0, np.int64),
         spring_bodies=np.zeros((0, 2), np.int64), spring_params=np.zeros((0, SPRING_COLUMNS)),
         torsion_bodies=np.zeros((0, 2), np.int64), torsion_params=np.zeros((0, TORSION_COLUMNS)),
+        driveline_kinds=np.zeros((0, 2), np.int64), driveline_bodies=np.zeros((0, 2), np.int64),
+        driveline_params=np.zeros((0, DRIVELINE_COLUMNS)), driveline_table=np.zeros((0, 3)),
     ))
 
 

@@ -62,8 +62,8 @@ def draws(k):
     return overrides
 
 
-def run_case(folder, name, overrides):
-    """The result file of one case, run unless a complete one is there."""
+def run_case(folder, name, overrides, config=CONFIG):
+    """The result file of one case of `config` (default the bundled model), run unless a complete one is there."""
     output = folder / f"{name}.h5"
     if output.exists():
         try:
@@ -71,7 +71,7 @@ def run_case(folder, name, overrides):
                 return output
         except NotAResultFile:  # a half-written file from an interrupted run: run it again
             output.unlink()
-    loaded = load_mechanism(CONFIG, list(overrides))
+    loaded = load_mechanism(config, list(overrides))
     report = run_to_file(prepare(loaded), loaded, output)
     if not report.complete:
         print(f"{name}: {report.status}", file=sys.stderr)

@@ -24,6 +24,7 @@ import numpy as np
 
 CONFIGS = Path(__file__).resolve().parents[1] / "clearsim" / "configs"
 UHV, UHV_FLEXIBLE = CONFIGS / "uhv_breaker.yaml", CONFIGS / "uhv_breaker_flexible.yaml"
+UHV_HYDRAULIC = CONFIGS / "uhv_breaker_hydraulic.yaml"
 CRANK, CRANK_FRICTION = CONFIGS / "slider_crank_flores.yaml", CONFIGS / "slider_crank_flores_friction.yaml"
 RESULTS = Path(__file__).resolve().parent / "results"
 TIGHTER = 100.0
@@ -41,6 +42,7 @@ CASES = [
     Case("uhv-ideal", UHV, ("joints.A.clearance=0", "joints.J.clearance=0")),
     Case("uhv-c0.01", UHV, (), ("solver.t_end=10ms",)),
     Case("uhv-c0.1", UHV, ("joints.A.clearance=0.1mm", "joints.J.clearance=0.1mm"), ("solver.t_end=10ms",)),
+    Case("uhv-hydraulic", UHV_HYDRAULIC, ("solver.t_end=85ms",), ("solver.t_end=10ms",)),  # uhv-c0.01's stroke, force-driven
     Case("uhv-flex-ideal", UHV_FLEXIBLE, ("joints.A.clearance=0", "joints.J.clearance=0")),
     Case("uhv-flex-c0.01", UHV_FLEXIBLE, (), ("solver.t_end=10ms",)),
     Case("uhv-flex-c0.1", UHV_FLEXIBLE, ("joints.A.clearance=0.1mm", "joints.J.clearance=0.1mm"), ("solver.t_end=10ms",)),

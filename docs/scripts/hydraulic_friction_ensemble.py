@@ -14,7 +14,8 @@ their 85 ms. 4 × N runs of ≈ 1 s; re-running reuses complete result files.
 Per run, from the moving contact's travel with the hydraulic file's `travel:` block (clearsim.travel, the figures of
 `clearsim run`): the closing time (command to contact touch, 250 mm) and the contact-zone speed (200 → 250 mm); and,
 up to the touch, the energies that explain them: the work friction took (A and J), the work the drive gave the
-mechanism (the cylinder's ∫F ds, or the prescribed driver's work) and the kinetic energy at the touch.
+mechanism (the cylinder's ∫F ds, or the prescribed driver's work) and the kinetic energy at the touch; and the
+paper's figure, the peak |a| of the moving contact over the stroke (0–85 ms).
 Printed: per drive, the mean paired change with its 95 % confidence interval (Student t over the N pairs), the
 relative change, and how many pairs change the same way.
 """
@@ -42,9 +43,11 @@ LABELS = {"closing_ms": "closing time, command → touch at 250 mm (ms)",
           "zone_speed": "contact-zone speed, 200 → 250 mm (m/s)",
           "friction_J": "friction work at A and J up to the touch (J)",
           "drive_J": "work the drive gave the mechanism up to the touch (J)",
-          "kinetic_J": "kinetic energy at the touch (J)"}
-FORMATS = {"closing_ms": ".3f", "zone_speed": ".4f", "friction_J": ".2f", "drive_J": ".1f", "kinetic_J": ".1f"}
+          "kinetic_J": "kinetic energy at the touch (J)",
+          "peak": "peak \\|a\\| of the moving contact, 0–85 ms (m/s²)"}
+FORMATS = {"closing_ms": ".3f", "zone_speed": ".4f", "friction_J": ".2f", "drive_J": ".1f", "kinetic_J": ".1f", "peak": ".0f"}
 TRAVEL = load_mechanism(HYDRAULIC, []).mechanism.travel
+STROKE_END_S = 0.085  # the peak acceleration over the stroke: the prescribed drive's last sample (its jump) left out
 
 
 def drive_work(data):
@@ -69,7 +72,8 @@ def merit(path):
 
     return {"closing_ms": touch * 1e3, "zone_speed": figures["zone_speed_m_per_s"],
             "friction_J": at_touch(data["energy/friction_dissipated"]), "drive_J": at_touch(drive_work(data)),
-            "kinetic_J": at_touch(data["energy/kinetic"])}
+            "kinetic_J": at_touch(data["energy/kinetic"]),
+            "peak": float(np.max(np.abs(data["sensors/contact_acceleration"][time < STROKE_END_S])))}
 
 
 def run_drive(folder, samples, drive):

@@ -411,9 +411,9 @@ def _paired_text(paired: dict | None) -> str:
 
 
 def _studies() -> dict:
-    from benchmarks import exudyn_slider_crank, extras, scaling, solve_ivp_cartesian, solve_ivp_slider_crank
+    from benchmarks import chain, exudyn_slider_crank, extras, scaling, solve_ivp_cartesian, solve_ivp_slider_crank
 
-    return {"peer": exudyn_slider_crank.peer, "baseline": solve_ivp_slider_crank.baseline,
+    return {"chain": chain.chain, "peer": exudyn_slider_crank.peer, "baseline": solve_ivp_slider_crank.baseline,
             "baseline-cartesian": solve_ivp_cartesian.baseline,
             "compile": extras.compile_time, "memory": extras.memory, "scaling": scaling.scaling,
             "diagnose": extras.diagnose_throughput, "sweep-keep": extras.sweep_keep}
@@ -427,7 +427,7 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="1 repeat, shortened cases, short sweep and studies")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--cases", help="comma-separated names (default: all): " + ", ".join(c.name for c in CASES)
-                        + ", sweep-8, profile, peer, baseline, baseline-cartesian, compile, memory, scaling, diagnose, "
+                        + ", sweep-8, profile, peer, baseline, baseline-cartesian, compile, memory, scaling, chain, diagnose, "
                         "sweep-keep")
     parser.add_argument("--json", type=Path, default=RESULTS / "latest.json")
     parser.add_argument("--compare", type=Path, help="an earlier JSON: wall-time ratios per case")
@@ -435,6 +435,7 @@ def main(argv=None) -> int:
     from rich.console import Console
 
     from benchmarks import extras
+    from benchmarks.chain import describe as describe_chain
     from benchmarks.scaling import figure
 
     console = Console(width=220)
@@ -480,6 +481,8 @@ def main(argv=None) -> int:
     for name in ("profile", "compile", "memory", "scaling", "diagnose", "sweep-keep"):
         if name in document:
             console.print(extras.describe(name, document[name]))
+    if "chain" in document:
+        console.print(describe_chain(document["chain"]))
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(json.dumps(document, indent=2, default=_plain) + "\n")
     console.print(f"results: {args.json}")

@@ -111,6 +111,8 @@ WORKSPACE_FIELDS = [
     "solve_schur",  # (rows, rows) S = Φ_q M⁻¹ Φ_qᵀ
     "solve_lower",  # (rows, rows) its envelope Cholesky factor (only the envelope is written and read)
     "solve_envelope",  # (rows,) first column of each row's envelope
+    "solve_band",  # (rows,) first column each row of S can have nonzero (rows sharing a body); S is zero left of it
+    "solve_next_row",  # (rows,) the back substitution's list of the rows whose envelope reaches a column
     "solve_body_start",  # (nb + 1,) the row blocks of body b are solve_entries[start[b]:start[b + 1]]
     "solve_entries",  # (2 rows, 2) (row, slot) of each row block, grouped by body
     "solve_body_fill",  # (nb,)
@@ -142,7 +144,8 @@ def _workspace(arrays: SystemArrays) -> tuple:
     with np.errstate(divide="ignore"):  # as the kernels divide: a zero mass or inertia gives inf, not a warning
         inverse_mass = 1.0 / mass_diagonal(arrays)
     return (inverse_mass, np.zeros((rows, 2, 3)), np.zeros((rows, 2), np.int64), np.zeros((rows, rows)),
-            np.zeros((rows, rows)), np.zeros(rows, np.int64), np.zeros(bodies + 1, np.int64),
+            np.zeros((rows, rows)), np.zeros(rows, np.int64), np.arange(rows, dtype=np.int64), np.zeros(rows, np.int64),
+            np.zeros(bodies + 1, np.int64),
             np.zeros((2 * rows, 2), np.int64), np.zeros(bodies, np.int64), np.zeros(3 * bodies), np.zeros(rows),
             np.zeros(1 + arrays.clearance_bodies.shape[0], np.int64), np.zeros(3 * bodies))
 

@@ -161,9 +161,23 @@ def jacobian_transpose_times(blocks, bodies, lam, out):
 
 
 @njit(cache=True)
+def clear_band(schur, band):
+    """S[i, band[i]:i + 1] = S[band[i]:i + 1, i] = 0 for every row i: what the last schur_complement wrote."""
+    for i in range(band.shape[0]):
+        for j in range(band[i], i + 1):
+            schur[i, j] = 0.0
+            schur[j, i] = 0.0
+
+
+@njit(cache=True)
 def schur_complement(system, blocks, bodies):
     """S = Φ_q M⁻¹ Φ_qᵀ from the blocks into system.solve_schur (its leading rows × rows): rows couple only
-    through a shared body, so S is summed body by body."""
+    through a shared body, so S is summed body by body.
+
+    Row i of S can be nonzero from column band[i] on (system.solve_band: the first row sharing a body with it;
+    the rows past these blocks' have band[i] = i and an empty row). Only the band of the last call is cleared and
+    only the band is written, so a call costs O(rows × bandwidth), not O(rows²), and S is zero outside the band.
+    """
     m = blocks.shape[0]
     minv = system.inverse_mass
     nb = minv.shape[0] // 3
@@ -187,9 +201,15 @@ def schur_complement(system, blocks, bodies):
                 entries[filled[b], 0], entries[filled[b], 1] = row, slot
                 filled[b] += 1
     schur = system.solve_schur
-    for i in range(m):
-        for j in range(m):
-            schur[i, j] = 0.0
+    band = system.solve_band
+    clear_band(schur, band)
+    for row in range(band.shape[0]):
+        band[row] = row
+    for row in range(m):
+        for slot in range(2):
+            b = bodies[row, slot]
+            if b >= 0:
+                band[row] = min(band[row], entries[count[b], 0])  # the body's rows are grouped in ascending order
     for b in range(nb):
         for e in range(count[b], count[b + 1]):
             i, si = entries[e, 0], entries[e, 1]

@@ -56,14 +56,16 @@ def factorize(system, m):
     """Envelope (skyline) Cholesky factor of the symmetric m × m matrix S in system.solve_schur (small, dense)
     into system.solve_lower; False if S is not positive definite.
 
-    Row i of L starts where row i of S does (first[i]), since the factor has no fill-in left of the
-    envelope, so the zeros of a chain's S cost nothing; only the envelope of solve_lower is written and read.
+    Row i of L starts where row i of S does (first[i], its first nonzero, searched from the band schur_complement
+    wrote), since the factor has no fill-in left of the envelope, so the zeros of a chain's S cost nothing; only the
+    envelope of solve_lower is written and read: O(rows × bandwidth²).
     """
     matrix = system.solve_schur
     first = system.solve_envelope
+    band = system.solve_band
     for i in range(m):
         first[i] = i
-        for j in range(i):
+        for j in range(band[i], i):
             if matrix[i, j] != 0.0:
                 first[i] = j
                 break
@@ -84,7 +86,13 @@ def factorize(system, m):
 
 @njit(cache=True)
 def solve_factored(system, x):
-    """x ← S⁻¹ x in place with the factor of the last factored_jacobian (NaN if S was not positive definite)."""
+    """x ← S⁻¹ x in place with the factor of the last factored_jacobian (NaN if S was not positive definite).
+
+    Both substitutions loop over the envelope only, O(envelope): the forward one along row i of L from first[i],
+    the backward one down column i of L, over the rows k > i whose envelope reaches it (first[k] ≤ i) in ascending
+    order. Those rows are a linked list (system.solve_next_row) kept while i descends: row i + 1 joins at its head,
+    a row leaves when i passes its first column, and never comes back.
+    """
     m = x.shape[0]
     if system.factor_key[0] != FACTOR_SPD:
         for r in range(m):
@@ -96,10 +104,25 @@ def solve_factored(system, x):
         for k in range(first[i], i):
             x[i] -= lower[i, k] * x[k]
         x[i] /= lower[i, i]
+    following = system.solve_next_row
+    head = -1  # the first row of the list, −1: empty; following[k]: the row after k
     for i in range(m - 1, -1, -1):
-        for k in range(i + 1, m):
-            if first[k] <= i:
+        if i + 1 < m and first[i + 1] <= i:
+            following[i + 1] = head
+            head = i + 1
+        previous = -1
+        k = head
+        while k >= 0:
+            after = following[k]
+            if first[k] > i:
+                if previous < 0:
+                    head = after
+                else:
+                    following[previous] = after
+            else:
                 x[i] -= lower[k, i] * x[k]
+                previous = k
+            k = after
         x[i] /= lower[i, i]
 
 

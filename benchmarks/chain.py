@@ -18,6 +18,8 @@ import statistics
 import tempfile
 from pathlib import Path
 
+from benchmarks.scaling import timed_run
+
 LENGTH, SECTION, DENSITY = 0.1, 0.01, 7850.0  # m, m, kg/m³
 MASS = DENSITY * LENGTH * SECTION**2  # kg
 INERTIA = MASS * (LENGTH**2 + SECTION**2) / 12.0  # kg m² about the centre
@@ -45,22 +47,6 @@ def pendulum_chain(links: int, clearance_joints: int, t_end: float = T_END) -> s
     return "\n".join(lines) + "\n"
 
 
-def _timed_run(system) -> dict:
-    """One integration of a prepared system: its statistics (wall time of the compiled loop)."""
-    from clearsim.solver.simulate import Run
-
-    run = Run(system)
-    try:
-        for _chunk in run.chunks():
-            pass
-        complete = True
-    except Exception:  # noqa: BLE001 — a chain that fails is a row marked incomplete, not a crash
-        complete = False
-    stats = run.statistics()
-    return {"complete": complete, "steps": stats.steps, "rhs_evaluations": stats.rhs_evaluations,
-            "integration_s": stats.wall_time}
-
-
 def row(links: int, clearances: int, t_end: float, repeats: int, folder: Path) -> dict:
     """Medians over `repeats` timed runs (after one untimed run) of one chain."""
     from clearsim.model.loader import load_mechanism_text
@@ -68,8 +54,8 @@ def row(links: int, clearances: int, t_end: float, repeats: int, folder: Path) -
 
     loaded = load_mechanism_text(pendulum_chain(links, clearances, t_end), f"chain-{links}-{clearances}.yaml", (), folder)
     system = prepare(loaded)
-    _timed_run(system)  # warm-up: this size's first call
-    runs = [_timed_run(system) for _ in range(repeats)]
+    timed_run(system)  # warm-up: this size's first call
+    runs = [timed_run(system) for _ in range(repeats)]
     walls = [r["integration_s"] for r in runs]
     last = runs[-1]
     return {"links": links, "clearance_joints": clearances, "constraint_rows": 2 * links + 1,

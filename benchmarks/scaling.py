@@ -71,28 +71,35 @@ def validates(text: str, folder: Path) -> bool:
     return done.returncode == 0
 
 
+def timed_run(system) -> dict:
+    """One integration of a prepared system: complete or not, steps, RHS and the compiled loop's wall time."""
+    from clearsim.solver.simulate import Run
+
+    run = Run(system)
+    try:
+        for _chunk in run.chunks():
+            pass
+        complete = True
+    except Exception:  # noqa: BLE001 — a chain that fails is a row marked incomplete, not a crash
+        complete = False
+    stats = run.statistics()
+    return {"complete": complete, "steps": stats.steps, "rhs_evaluations": stats.rhs_evaluations,
+            "integration_s": stats.wall_time}
+
+
 def _row(bars: int, clearances: int, t_end: float, folder: Path) -> dict:
     from clearsim.model.loader import load_mechanism_text
     from clearsim.runner import prepare
-    from clearsim.solver.simulate import Run
 
     loaded = load_mechanism_text(four_bar_chain(bars, clearances, t_end), f"chain-{bars}-{clearances}.yaml", (), folder)
     system = prepare(loaded)
-    walls, stats = [], None
-    for _ in range(2):  # the first run loads this size's kernels; the second is timed
-        run = Run(system)
-        try:
-            for _chunk in run.chunks():
-                pass
-            complete = True
-        except Exception:  # noqa: BLE001 — a chain that fails is a row marked incomplete, not a crash
-            complete = False
-        stats = run.statistics()
-        walls.append(stats.wall_time)
+    timed_run(system)  # the first run loads this size's kernels; the second is timed
+    run = timed_run(system)
+    wall = run["integration_s"]
     return {"bars": bars, "bodies": 2 * bars + 1, "clearance_joints": clearances, "coordinates": system.coordinate_count,
-            "steps": stats.steps, "rhs_evaluations": stats.rhs_evaluations, "integration_s": walls[-1],
-            "us_per_step": 1e6 * walls[-1] / max(stats.steps, 1), "us_per_rhs": 1e6 * walls[-1] / max(stats.rhs_evaluations, 1),
-            "complete": complete}
+            "steps": run["steps"], "rhs_evaluations": run["rhs_evaluations"], "integration_s": wall,
+            "us_per_step": 1e6 * wall / max(run["steps"], 1), "us_per_rhs": 1e6 * wall / max(run["rhs_evaluations"], 1),
+            "complete": run["complete"]}
 
 
 def _order(rows: list[dict], x: str, y: str) -> float | None:

@@ -239,40 +239,49 @@ def flexible_problems(mechanism) -> list[Problem]:
     return problems
 
 
-def initial_tensions(document: dict, splits: list[LinkSplit], base_dir) -> list[float]:
-    """Each split link's axial tension at t = 0 in the model as given (N): the splits with their slides locked by
-    drivers (the rigid links again), assembled, and each lock's multiplier at t = 0 (the force along the link on
-    the second half is −λ·axis, as a spring's tension λ). 0 when that model cannot be assembled."""
+def lock_multipliers(locked: dict, locks: list[tuple[str, str]], base_dir) -> list[float]:
+    """The multiplier at t = 0 of each lock (driver name, joint) added to a copy of `locked`: a driver holding the
+    joint's relative coordinate at its t = 0 value. The model is assembled and its accelerations solved at t = 0, so
+    λ is the force (prismatic) or moment (revolute) the joint carries then, its sign as a spring's between the joint's
+    two bodies: the tension of an axial spring, the torque T = k (θ_j − θ_i − θ₀) of a rotational one. 0 each when
+    that model cannot be assembled."""
     from clearsim.assembly.arrays import for_kernels
     from clearsim.assembly.build import BuildError
     from clearsim.assembly.dynamics import accelerations, generalized_forces
     from clearsim.assembly.hydraulics import add_hydraulic_forces
     from clearsim.assembly.system import assemble
 
-    locked = copy.deepcopy(document)
-    for split in splits:
-        split_link(locked, split)
-    locks = [f"{split.guide}_lock" for split in splits]
+    locked = copy.deepcopy(locked)
     locked["drivers"] = (locked.get("drivers") or []) + [
-        {"name": lock, "joint": split.guide, "motion": {"law": "polynomial", "coefficients": [0.0]}}
-        for lock, split in zip(locks, splits)]
+        {"name": lock, "joint": joint, "motion": {"law": "polynomial", "coefficients": [0.0]}} for lock, joint in locks]
     try:
         system = assemble(validate_mechanism(locked), base_dir)
     except (BuildError, ClearsimError, ValueError):
-        return [0.0] * len(splits)
+        return [0.0] * len(locks)
     free = np.zeros(len(system.clearance_joints), np.int64)  # every journal starts in free flight (mode FREE)
     kernel_arrays = for_kernels(system.arrays)
     forces = generalized_forces(kernel_arrays, 0.0, system.q0, system.qd0, free, np.zeros(free.size))[0]
     add_hydraulic_forces(kernel_arrays, system.q0, system.z0, forces)
     multipliers = accelerations(kernel_arrays, 0.0, system.q0, system.qd0, forces, free)[1]
-    return [float(multipliers[dict(system.drivers)[lock]]) for lock in locks]
+    return [float(multipliers[dict(system.drivers)[lock]]) for lock, _ in locks]
+
+
+def initial_tensions(document: dict, splits: list[LinkSplit], base_dir) -> list[float]:
+    """Each split link's axial tension at t = 0 in the model as given (N): the splits with their slides locked (the
+    rigid links again) and each lock's multiplier (the force along the link on the second half is −λ·axis, as a
+    spring's tension λ)."""
+    locked = copy.deepcopy(document)
+    for split in splits:
+        split_link(locked, split)
+    return lock_multipliers(locked, [(f"{split.guide}_lock", split.guide) for split in splits], base_dir)
 
 
 def expanded_document(document: dict, mechanism, base_dir) -> dict:
     """A copy of the document with every axial link split, its spring carrying the rigid link's tension at t = 0,
-    and every beam link cut into segments, unstressed at t = 0; with beam links, every body starts with the velocity
-    of the rigid mechanism at t = 0, so that no segment starts bending (the velocity nearest to the file's that the
-    chain allows would) (flexible_problems found none; `base_dir`: where the file's tables are)."""
+    and every beam link cut into segments, its bend springs carrying the rigid link's moments at t = 0; with beam
+    links, every body starts with the velocity of the rigid mechanism at t = 0, so that no segment starts bending
+    (the velocity nearest to the file's that the chain allows would) (flexible_problems found none; `base_dir`:
+    where the file's tables are)."""
     revolute, _ = joint_lists(mechanism)
     flexible = [body for body in mechanism.bodies if isinstance(body.flexible, AxialFlexibility)]
     splits = [link_split(mechanism, body.name, revolute[body.name]) for body in flexible]
@@ -287,8 +296,8 @@ def expanded_document(document: dict, mechanism, base_dir) -> dict:
     if beams:
         velocities = rigid_velocities(mechanism, base_dir)
         set_velocities(expanded, velocities)
-        for body in beams:
-            expand_beam(expanded, mechanism, body, velocities[body])
+        segments = {body: expand_beam(expanded, mechanism, body, velocities[body]) for body in beams}
+        set_start_moments(expanded, mechanism, segments, base_dir)
     return expanded
 
 
@@ -513,9 +522,9 @@ def set_velocities(document: dict, velocities: dict[str, tuple[float, float, flo
             entry["angular_velocity"] = si_text(rate, "angular_speed")
 
 
-def expand_beam(document: dict, mechanism, body: str, velocity: tuple[float, float, float]) -> None:
+def expand_beam(document: dict, mechanism, body: str, velocity: tuple[float, float, float]) -> BeamSegments:
     """Replace a beam link (beam_problems found none) by its segments, hinges and rotational springs in `document`;
-    they start straight, moving as the rigid link with `velocity` (v_x, v_y, ω)."""
+    they start straight and unstressed, moving as the rigid link with `velocity` (v_x, v_y, ω). Its segments."""
     from clearsim.assembly.build import initial_poses
 
     poses = initial_poses(mechanism)
@@ -549,3 +558,17 @@ def expand_beam(document: dict, mechanism, body: str, velocity: tuple[float, flo
         {"type": "rotational_spring", "name": f"{body}_bend{k + 1}", "bodies": [names[k], names[k + 1]],
          "stiffness": si_text(stiffness, "rotational_stiffness"), "damping": si_text(damping, "rotational_damping")}
         for k in range(layout.elements)]
+    return segments
+
+
+def set_start_moments(expanded: dict, mechanism, beams: dict[str, BeamSegments], base_dir) -> None:
+    """Each bend spring of the beam links ({body: its segments}) in `expanded` starts carrying the moment M its hinge
+    carries at t = 0 with every hinge locked (the rigid links again, lock_multipliers): its free angle θ₀ = −M/k (the
+    segments start in line), so T = k (0 − θ₀) = M and the released model starts in the rigid one's dynamic
+    equilibrium, its spring energy the beam's strain energy M²/(2k)."""
+    bends = [(f"{body}_hinge{k + 1}", f"{body}_bend{k + 1}", segments.stiffness(mechanism.body(body).flexible))
+             for body, segments in beams.items() for k in range(segments.layout.elements)]
+    moments = lock_multipliers(expanded, [(f"{hinge}_lock", hinge) for hinge, _, _ in bends], base_dir)
+    springs = {force["name"]: force for force in expanded["forces"] if force.get("type") == "rotational_spring"}
+    for (_, bend, stiffness), moment in zip(bends, moments):
+        springs[bend]["free_angle"] = si_text(-moment / stiffness, "angle")

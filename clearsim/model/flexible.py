@@ -14,7 +14,9 @@ segments Δ/2 long), pins `<body>_hinge<k>` and rotational springs `<body>_bend<
 middles. The segments' masses, centres of mass and inertias are the moments of one density along the axis,
 ρ(u) = a + b u + c u², fitted to the file's mass, centre of mass and inertia. Joints, sensors, loads and springs
 go to the segment holding their point's projection on the axis; the segment holding the first joint keeps the
-body's name, the others are `<body>_s<k>` (docs/model.md, "Flexible links: the beam element").
+body's name, the others are `<body>_s<k>`. The bend springs start carrying the moments the rigid link carries at
+its hinges at t = 0, as the axial spring starts at its tension (lock_multipliers: the model with those joints locked
+by drivers, its multipliers at t = 0) (docs/model.md, "Flexible links: the beam element").
 """
 
 from __future__ import annotations

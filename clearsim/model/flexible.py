@@ -299,7 +299,7 @@ def expanded_document(document: dict, mechanism, base_dir) -> dict:
         velocities = rigid_velocities(mechanism, base_dir)
         set_velocities(expanded, velocities)
         segments = {body: expand_beam(expanded, mechanism, body, velocities[body]) for body in beams}
-        set_start_moments(expanded, mechanism, segments, base_dir)
+        set_start_moments(expanded, mechanism, segments, [split.guide for split in splits], base_dir)
     return expanded
 
 
@@ -563,14 +563,17 @@ def expand_beam(document: dict, mechanism, body: str, velocity: tuple[float, flo
     return segments
 
 
-def set_start_moments(expanded: dict, mechanism, beams: dict[str, BeamSegments], base_dir) -> None:
+def set_start_moments(expanded: dict, mechanism, beams: dict[str, BeamSegments], slides: list[str], base_dir) -> None:
     """Each bend spring of the beam links ({body: its segments}) in `expanded` starts carrying the moment M its hinge
-    carries at t = 0 with every hinge locked (the rigid links again, lock_multipliers): its free angle θ₀ = −M/k (the
-    segments start in line), so T = k (0 − θ₀) = M and the released model starts in the rigid one's dynamic
-    equilibrium, its spring energy the beam's strain energy M²/(2k)."""
+    carries at t = 0 with every hinge and every axial link's slide (`slides`) locked (the rigid mechanism again,
+    lock_multipliers): its free angle θ₀ = −M/k (the segments start in line), so T = k (0 − θ₀) = M and the released
+    model starts in the rigid one's dynamic equilibrium, its spring energy the beam's strain energy M²/(2k). The
+    slides are locked so that the assembly closes the chain as the rigid one does (free, it could close a journal's
+    start eccentricity by stretching a stiff axial spring, whose force the hinges would then carry)."""
     bends = [(f"{body}_hinge{k + 1}", f"{body}_bend{k + 1}", segments.stiffness(mechanism.body(body).flexible))
              for body, segments in beams.items() for k in range(segments.layout.elements)]
-    moments = lock_multipliers(expanded, [(f"{hinge}_lock", hinge) for hinge, _, _ in bends], base_dir)
+    joints = [hinge for hinge, _, _ in bends] + slides
+    moments = lock_multipliers(expanded, [(f"{joint}_lock", joint) for joint in joints], base_dir)[:len(bends)]
     springs = {force["name"]: force for force in expanded["forces"] if force.get("type") == "rotational_spring"}
     for (_, bend, stiffness), moment in zip(bends, moments):
         springs[bend]["free_angle"] = si_text(-moment / stiffness, "angle")

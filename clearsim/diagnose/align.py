@@ -254,7 +254,20 @@ class Record:
 
     @property
     def effective_samples(self) -> float:
-        return float(sum(n.effective_samples for n in self.noise.values()))
+        """n_eff of the compared samples, all sensors together: χ²'s expectation on noise alone."""
+        kept = len(range(*self.compared.indices(len(self.time)))) / max(len(self.time), 1)
+        return float(kept * sum(n.effective_samples for n in self.noise.values()))
+
+    @property
+    def compared(self) -> slice:
+        """The samples every comparison uses: all but the comparison filter's start-up at each end (1/f_c). There the
+        filtered record holds the noise of its first or last sample nearly unfiltered (the filter's odd padding
+        repeats it): 57 σ̂² at the end sample, still 2 σ̂² half a start-up in (4th-order Butterworth run forward and
+        backward), so gaps, χ², the noise test and the disagreement windows all leave it out."""
+        if self.cutoff is None:
+            return slice(None)
+        edge = int(np.ceil(self.rate / self.cutoff))
+        return slice(edge, len(self.time) - edge) if len(self.time) > 4 * edge else slice(None)
 
 
 def uniform_grid(time: np.ndarray) -> np.ndarray:
@@ -334,22 +347,28 @@ def residuals(record: Record, prediction: dict[str, np.ndarray]) -> dict[str, np
 
 
 def chi_square(record: Record, residual: dict[str, np.ndarray]) -> float:
-    """χ² = Σ_s (n_eff,s/N_s) Σ_k r_sk²/σ̂_s² (docs/diagnose.md eq. D3)."""
+    """χ² = Σ_s (n_eff,s/N_s) Σ_k r_sk²/σ̂_s² over the compared samples (docs/diagnose.md eq. D3)."""
+    return _weighted_squares(record, {s: r[record.compared] for s, r in residual.items()})
+
+
+def _weighted_squares(record: Record, residual: dict[str, np.ndarray]) -> float:
     weights = record.weights
     return float(sum(weights[s] * np.sum(r ** 2) for s, r in residual.items()))
 
 
 def chi_square_halves(record: Record, residual: dict[str, np.ndarray]) -> tuple[float, float]:
-    """χ² (D3) of the first and of the second half of the record, for a check on data the other half fitted."""
-    middle = len(record.time) // 2
-    first = {s: r[:middle] for s, r in residual.items()}
-    second = {s: r[middle:] for s, r in residual.items()}
-    return chi_square(record, first), chi_square(record, second)
+    """χ² (D3) of the first and of the second half of the compared samples, for a check on data the other half
+    fitted."""
+    compared = {s: r[record.compared] for s, r in residual.items()}
+    middle = len(next(iter(compared.values()), [])) // 2
+    first = {s: r[:middle] for s, r in compared.items()}
+    second = {s: r[middle:] for s, r in compared.items()}
+    return _weighted_squares(record, first), _weighted_squares(record, second)
 
 
 def sensor_gaps(record: Record, residual: dict[str, np.ndarray]) -> dict[str, float]:
-    """g_s = RMS(r_s)/σ̂_s (docs/diagnose.md eq. D1)."""
-    return {s: float(np.sqrt(np.mean(r ** 2)) / record.noise[s].std) for s, r in residual.items()}
+    """g_s = RMS(r_s)/σ̂_s over the compared samples (docs/diagnose.md eq. D1)."""
+    return {s: float(np.sqrt(np.mean(r[record.compared] ** 2)) / record.noise[s].std) for s, r in residual.items()}
 
 
 def combined_gap(gaps: dict[str, float]) -> float:
@@ -402,7 +421,7 @@ def scan_costs(record: Record, model_time: np.ndarray, model: dict[str, np.ndarr
     for s in record.values:
         filtered = lowpass(np.interp(widened, model_time, model[s]), record.cutoff, record.rate)
         windows = np.lib.stride_tricks.sliding_window_view(filtered, len(record.time))[starts]
-        costs += weights[s] * np.sum((record.values[s] - windows) ** 2, axis=1)
+        costs += weights[s] * np.sum(((record.values[s] - windows)[:, record.compared]) ** 2, axis=1)
     return costs
 
 
@@ -456,22 +475,13 @@ def residual_effective_samples(residual: np.ndarray) -> float:
     return float(count / (1.0 + 2.0 * np.sum((1.0 - lags / count) * rho[1:last] ** 2)))
 
 
-def settled(record: Record, residual: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """The residual without the comparison filter's start-up at each end (1/f_c): there the filtered record holds the
-    noise of its first or last sample unfiltered (the filter's padding repeats it), up to √(f_s/2f_c) times σ̂."""
-    if record.cutoff is None:
-        return residual
-    edge = int(np.ceil(record.rate / record.cutoff))
-    return {s: r[edge:len(r) - edge] if len(r) > 4 * edge else r for s, r in residual.items()}
-
-
 def noise_test(record: Record, residual: dict[str, np.ndarray]) -> NoiseTest:
-    """The residual (in the comparison band, `settled`) against the noise, per sensor: p = P(F(n_eff, ν) ≥ gap²)."""
+    """The residual (in the comparison band, its compared samples) against the noise, per sensor:
+    p = P(F(n_eff, ν) ≥ gap²)."""
     from scipy.stats import f as fisher
 
-    residual = settled(record, residual)
     gaps = sensor_gaps(record, residual)
-    effective = {s: residual_effective_samples(r) for s, r in residual.items()}
+    effective = {s: residual_effective_samples(r[record.compared]) for s, r in residual.items()}
     p_values = {s: float(fisher.sf(gaps[s] ** 2, effective[s], min(record.noise[s].degrees_of_freedom, 1e9)))
                 for s in residual}
     return NoiseTest(gaps, effective, p_values)

@@ -83,16 +83,17 @@ class Window:
 
 
 def disagreement_windows(record: Record, residual: dict[str, np.ndarray]) -> list[Window]:
-    """Time windows where the 1-ms moving RMS of the residual exceeds BAND noise levels."""
+    """Time windows where the 1-ms moving RMS of the residual over the compared samples exceeds BAND noise levels."""
     width = max(int(round(WINDOW_SECONDS * record.rate)), 3)
     kernel = np.ones(width) / width
+    time = record.time[record.compared]
     out = []
     for sensor, r in residual.items():
-        level = np.sqrt(np.convolve(r ** 2, kernel, mode="same")) / record.noise[sensor].std
+        level = np.sqrt(np.convolve(r[record.compared] ** 2, kernel, mode="same")) / record.noise[sensor].std
         flagged = level > BAND
         edges = np.diff(np.concatenate([[0], flagged.astype(int), [0]]))
         for start, stop in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]):
-            out.append(Window(sensor, float(record.time[start]), float(record.time[stop - 1]),
+            out.append(Window(sensor, float(time[start]), float(time[stop - 1]),
                               float(level[start:stop].max())))
     return sorted(out, key=lambda w: -w.peak)
 

@@ -46,7 +46,7 @@ def test_the_trigger_offset_of_a_shifted_record_is_recovered_to_a_tenth_of_a_sam
 
 def test_the_offset_scan_is_the_chi_square_of_the_filtered_model_read_at_each_shifted_instant():
     """Each offset's window of the once-filtered model is that model interpolated at t_k − τ (what the scan was
-    before the windows): the same numbers, offset by offset."""
+    before the windows), over the compared samples: the same numbers, offset by offset."""
     model_time = np.linspace(0.0, 0.085, 8501)
     model = {"x": 0.2 * (model_time / 0.085) ** 2 * (3 - 2 * model_time / 0.085),
              "v": np.sin(2 * np.pi * 300.0 * model_time) + 0.1 * np.sin(2 * np.pi * 3000.0 * model_time)}
@@ -56,8 +56,8 @@ def test_the_offset_scan_is_the_chi_square_of_the_filtered_model_read_at_each_sh
     offsets = np.arange(-3e-3, 3e-3 + 0.5 * step, step)
     widened = np.arange(record.time[0] - offsets.max() - step, record.time[-1] - offsets.min() + 1.5 * step, step)
     filtered = {s: lowpass(np.interp(widened, model_time, m), record.cutoff, record.rate) for s, m in model.items()}
-    expected = [sum(record.weights[s] * np.sum((record.values[s] - np.interp(record.time - offset, widened, filtered[s]))
-                                               ** 2) for s in model) for offset in offsets]
+    expected = [sum(record.weights[s] * np.sum(((record.values[s] - np.interp(record.time - offset, widened, filtered[s]))
+                                                [record.compared]) ** 2) for s in model) for offset in offsets]
     costs = scan_costs(record, model_time, model, offsets)
     assert costs == pytest.approx(expected, rel=1e-12)
     assert offsets[np.argmin(costs)] == pytest.approx(0.7e-3, abs=step)

@@ -20,7 +20,7 @@ from clearsim.model.flexible import initial_tensions, link_split, point_text, se
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.resolve import is_clearance_joint, resolve_clearance
 from clearsim.model.schema import Mechanism, StrokeMotion
-from clearsim.units import si_text, to_si
+from clearsim.units import DIMENSIONS, si_text, to_si
 
 FAR_ANCHOR = 1000.0  # m: a damper anchored this far along its line acts in a fixed direction
 
@@ -49,7 +49,7 @@ class Candidate:
     def label(self) -> str:
         where = f" in joint {self.target}" if self.kind in JOINT_KINDS else (f" of {self.target}" if self.target else "")
         pin = f" (pin, R = {self.pin_radius * 1e3:.3g} mm)" if self.pin_radius is not None else ""
-        return f"{KIND_TITLES.get(self.kind, self.kind)}{where}{pin}" + (f" ({self.parameter})" if self.kind == "drive" else "")
+        return f"{KIND_TITLES.get(self.kind, self.kind)}{where}{pin}" + (f" ({self.parameter})" if self.kind in PARAMETER_NAMED else "")
 
     def applied(self, document: dict, value: float) -> dict:
         """A copy of the document with the parameter set to `value`."""
@@ -87,8 +87,11 @@ def with_effects(document: dict, candidates: list[Candidate], values) -> dict:
 
 KIND_TITLES = {"clearance": "clearance", "friction": "friction", "stiffness": "contact stiffness",
                "restitution": "restitution", "drive": "drive", "damping": "viscous damping", "mass": "mass",
-               "compliance": "axial compliance"}
+               "compliance": "axial compliance", "port_area": "port area", "precharge": "accumulator precharge",
+               "bulk_modulus": "oil bulk modulus", "preload": "spring preload", "dashpot": "dashpot",
+               "gas_load": "gas load", "guide_friction": "guide friction"}
 JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution"}
+PARAMETER_NAMED = {"drive", "port_area", "dashpot"}  # kinds with several parameters per target: the label names it
 
 
 def _set(document: dict, path: str, value) -> None:
@@ -290,9 +293,86 @@ def compliance(mechanism, document, base_dir: Path = Path(".")) -> list[Candidat
     return out
 
 
+@dataclass(frozen=True)
+class ForceParameter:
+    """A parameter of a force element of type `force_type`, written at `forces.<name>.<path>` in SI units of
+    `dimension`; scanned from `factors[0]` to `factors[1]` times its present value (log-spaced)."""
+
+    kind: str
+    force_type: str
+    parameter: str
+    path: str
+    dimension: str
+    factors: tuple[float, float]
+    display_unit: tuple[str, float]
+    present: Callable  # the force element → the parameter's value in the model as given (None: not this element's)
+
+
+def _force_candidates(mechanism, spec: ForceParameter) -> list[Candidate]:
+    """One candidate per force element of the spec's type that has the parameter."""
+    out = []
+    for force in mechanism.forces:
+        present = spec.present(force) if force.type == spec.force_type else None
+        if present is None or not present > 0.0:
+            continue
+
+        def write(doc, value, name=force.name):
+            _set(doc, f"forces.{name}.{spec.path}", si_text(value, spec.dimension))
+
+        out.append(Candidate(spec.kind, force.name, spec.parameter, DIMENSIONS[spec.dimension].si_unit,
+                             spec.factors[0] * present, spec.factors[1] * present, True, present, write,
+                             spec.display_unit))
+    return out
+
+
+def _force_kind(*specs: ForceParameter) -> Callable:
+    """A candidate kind made of force-element parameters."""
+    def kind(mechanism, document) -> list[Candidate]:
+        return [c for spec in specs for c in _force_candidates(mechanism, spec)]
+
+    kind.__doc__ = "; ".join(f"{s.parameter} of each {s.force_type}" for s in specs)
+    return kind
+
+
+def _accumulator_pressure(cylinder) -> float | None:
+    return cylinder.supply.pressure if cylinder.supply.type == "accumulator" else None
+
+
+PORT_AREA_FACTORS = (0.25, 4.0)  # a port choked by dirt or a worn valve seat (¼) to a bigger replacement orifice (4×)
+PRECHARGE_FACTORS = (0.5, 1.2)  # a leaking accumulator (half its charge) to an overcharged one
+BULK_MODULUS_FACTORS = (0.1, 2.0)  # entrained air and hoses (β/10) to a stiff, air-free circuit
+PRELOAD_FACTORS = (0.5, 1.2)  # a relaxed operating spring (half its preload) to an over-tensioned one
+DASHPOT_FACTORS = (0.1, 10.0)
+GAS_LOAD_FACTORS = (0.5, 2.0)  # the puffer's working area: a leaking puffer to a blocked nozzle
+GUIDE_FRICTION_FACTORS = (0.2, 5.0)  # μN: the contact fingers' preload and friction together
+
+port_area = _force_kind(
+    ForceParameter("port_area", "hydraulic_cylinder", "piston port area", "port_areas.piston", "area",
+                   PORT_AREA_FACTORS, ("mm²", 1e-6), lambda f: f.port_areas.piston),
+    ForceParameter("port_area", "hydraulic_cylinder", "rod port area", "port_areas.rod", "area",
+                   PORT_AREA_FACTORS, ("mm²", 1e-6), lambda f: f.port_areas.rod))
+precharge = _force_kind(ForceParameter("precharge", "hydraulic_cylinder", "accumulator precharge", "supply.pressure",
+                                       "pressure", PRECHARGE_FACTORS, ("bar", 1e5), _accumulator_pressure))
+bulk_modulus = _force_kind(ForceParameter("bulk_modulus", "hydraulic_cylinder", "bulk modulus", "bulk_modulus",
+                                          "pressure", BULK_MODULUS_FACTORS, ("GPa", 1e9), lambda f: f.bulk_modulus))
+preload = _force_kind(ForceParameter("preload", "spring_drive", "preload", "preload", "force", PRELOAD_FACTORS,
+                                     ("N", 1.0), lambda f: f.preload))
+dashpot = _force_kind(
+    ForceParameter("dashpot", "dashpot", "damping", "damping", "damping", DASHPOT_FACTORS, ("N·s/m", 1.0),
+                   lambda f: f.damping),
+    ForceParameter("dashpot", "dashpot", "orifice area", "orifice_area", "area", PORT_AREA_FACTORS, ("mm²", 1e-6),
+                   lambda f: f.orifice_area))
+gas_load = _force_kind(ForceParameter("gas_load", "gas_load", "puffer area", "area", "area", GAS_LOAD_FACTORS,
+                                      ("cm²", 1e-4), lambda f: f.area))
+guide_friction = _force_kind(ForceParameter("guide_friction", "guide_friction", "normal force", "normal_force", "force",
+                                            GUIDE_FRICTION_FACTORS, ("N", 1.0), lambda f: f.normal_force))
+
+
 KINDS: dict[str, Callable] = {"clearance": clearance, "friction": friction, "stiffness": stiffness,
                               "restitution": restitution, "drive": drive, "damping": damping, "mass": mass,
-                              "compliance": compliance}
+                              "compliance": compliance, "port_area": port_area, "precharge": precharge,
+                              "bulk_modulus": bulk_modulus, "preload": preload, "dashpot": dashpot,
+                              "gas_load": gas_load, "guide_friction": guide_friction}
 
 
 def candidates_for(mechanism, document: dict, kinds: list[str], base_dir: Path | str = ".") -> list[Candidate]:

@@ -19,6 +19,7 @@ import numpy as np
 from clearsim.errors import ClearsimError
 from clearsim.model.loader import dump_yaml
 from clearsim.sweep.worker import COMPLETE, CaseTask, run_case
+from clearsim.units import si_text
 
 
 @dataclass
@@ -61,7 +62,7 @@ class Evaluator:
         solver = document.setdefault("solver", {})
         rate = solver.get("output_rate")
         if rate is None or _hertz(rate) < self.min_output_rate:
-            solver["output_rate"] = float(self.min_output_rate)
+            solver["output_rate"] = si_text(self.min_output_rate, "frequency")  # with its unit: a file may declare none
         return document_text(document)
 
     def evaluate(self, documents: list[dict], then: Callable[[int, Prediction], Any] | None = None) -> list:

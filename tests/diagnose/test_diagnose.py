@@ -199,7 +199,9 @@ def test_candidate_documents_are_valid_mechanisms():
     loaded = load_mechanism(str(CONFIGS / "uhv_breaker.yaml"))
     document = yaml.safe_load(loaded.resolved_yaml)
     candidates = candidates_for(loaded.mechanism, document, list(KINDS))
-    assert {c.kind for c in candidates} == set(KINDS)
+    elements_it_lacks = {"beam_stiffness", "contact_length", "port_area", "precharge", "bulk_modulus", "preload",
+                         "dashpot", "gas_load", "guide_friction"}  # test_drive_candidates, test_link_contact_candidates
+    assert {c.kind for c in candidates} == set(KINDS) - elements_it_lacks
     for candidate in candidates:
         for value in (candidate.low, candidate.high):
             load_mechanism_text(document_text(candidate.applied(document, value)), "candidate", (), CONFIGS)

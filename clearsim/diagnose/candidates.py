@@ -87,10 +87,11 @@ def with_effects(document: dict, candidates: list[Candidate], values) -> dict:
 
 KIND_TITLES = {"clearance": "clearance", "friction": "friction", "stiffness": "contact stiffness",
                "restitution": "restitution", "drive": "drive", "damping": "viscous damping", "mass": "mass",
-               "compliance": "axial compliance", "port_area": "port area", "precharge": "accumulator precharge",
+               "compliance": "axial compliance", "beam_stiffness": "bending stiffness",
+               "contact_length": "pin contact length", "port_area": "port area", "precharge": "accumulator precharge",
                "bulk_modulus": "oil bulk modulus", "preload": "spring preload", "dashpot": "dashpot",
                "gas_load": "gas load", "guide_friction": "guide friction"}
-JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution"}
+JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution", "contact_length"}
 PARAMETER_NAMED = {"drive", "port_area", "dashpot"}  # kinds with several parameters per target: the label names it
 
 
@@ -179,11 +180,12 @@ def friction(mechanism, document) -> list[Candidate]:
     return out
 
 
-def _contact_candidates(mechanism, kind: str, key: str, unit: str, bounds, logarithmic: bool) -> list[Candidate]:
-    """One candidate per clearance joint for a key of its `contact:` block; bounds(present) → (low, high).
-    A unit ending in ^n is the contact exponent's."""
+def _contact_candidates(mechanism, kind: str, key: str, unit: str, bounds, logarithmic: bool,
+                        applies: Callable = lambda joint: True) -> list[Candidate]:
+    """One candidate per clearance joint (that `applies`) for a key of its `contact:` block; bounds(present) →
+    (low, high). A unit ending in ^n is the contact exponent's."""
     out = []
-    for joint in _clearance_joints(mechanism):
+    for joint in filter(applies, _clearance_joints(mechanism)):
         parameters = resolve_clearance(joint, mechanism.defaults)
         present = getattr(parameters, key)
         written_unit = unit.replace("^n", f"^{parameters.exponent:g}")
@@ -195,9 +197,36 @@ def _contact_candidates(mechanism, kind: str, key: str, unit: str, bounds, logar
     return out
 
 
+def _cylindrical(mechanism, joint) -> bool:
+    """The joint's elastic law is a cylindrical one: its stiffness follows from the pin's length and the materials."""
+    return resolve_clearance(joint, mechanism.defaults).elastic != "point_hertz"
+
+
 def stiffness(mechanism, document) -> list[Candidate]:
-    """Contact stiffness K of each clearance joint, from 1/10 to 10 times its present value."""
-    return _contact_candidates(mechanism, "stiffness", "stiffness", "N/m^n", lambda k0: (0.1 * k0, 10.0 * k0), True)
+    """Contact stiffness K of each clearance joint with the point-Hertz law, from 1/10 to 10 times its present value
+    (a cylindrical law has no K to write: its `length` candidate changes its stiffness)."""
+    return _contact_candidates(mechanism, "stiffness", "stiffness", "N/m^n", lambda k0: (0.1 * k0, 10.0 * k0), True,
+                               lambda joint: not _cylindrical(mechanism, joint))
+
+
+CONTACT_LENGTH_FACTORS = (0.25, 4.0)  # a pin bearing on a quarter of its length (edge loading, misalignment) to 4×
+
+
+def contact_length(mechanism, document) -> list[Candidate]:
+    """Axial length L of the pin in its bore, for each clearance joint with a cylindrical elastic law (the contact's
+    stiffness grows with it), ¼ … 4 times its present value."""
+    out = []
+    for joint in _clearance_joints(mechanism):
+        present = resolve_clearance(joint, mechanism.defaults).length
+        if not _cylindrical(mechanism, joint) or not present > 0.0:
+            continue
+
+        def write(doc, value, name=joint.name):
+            _set(doc, f"joints.{name}.contact.length", si_text(value, "length"))
+
+        out.append(Candidate("contact_length", joint.name, "length", "m", CONTACT_LENGTH_FACTORS[0] * present,
+                             CONTACT_LENGTH_FACTORS[1] * present, True, present, write, ("mm", 1e-3)))
+    return out
 
 
 def restitution(mechanism, document) -> list[Candidate]:
@@ -293,6 +322,27 @@ def compliance(mechanism, document, base_dir: Path = Path(".")) -> list[Candidat
     return out
 
 
+BEAM_STIFFNESS_BOUNDS = (0.1, 10.0)  # factor on E·I: a cracked or thinner section to a stiffer one
+
+
+def beam_stiffness(mechanism, document) -> list[Candidate]:
+    """Bending stiffness E·I of each beam link (`flexible: {model: beam}`), as a factor on it (written into E, so
+    every spring k = E I n / L and its damping scale with it), 0.1 … 10."""
+    out = []
+    for body in document.get("bodies") or []:
+        flexible = body.get("flexible") or {}
+        if flexible.get("model") != "beam":
+            continue
+        modulus = to_si(str(flexible["youngs_modulus"]), "pressure")
+
+        def write(doc, value, name=body["name"], modulus=modulus):
+            _set(doc, f"bodies.{name}.flexible.youngs_modulus", si_text(modulus * value, "pressure"))
+
+        out.append(Candidate("beam_stiffness", body["name"], "E·I factor", "", *BEAM_STIFFNESS_BOUNDS, True, 1.0, write,
+                             resonant=True))
+    return out
+
+
 @dataclass(frozen=True)
 class ForceParameter:
     """A parameter of a force element of type `force_type`, written at `forces.<name>.<path>` in SI units of
@@ -370,7 +420,8 @@ guide_friction = _force_kind(ForceParameter("guide_friction", "guide_friction", 
 
 KINDS: dict[str, Callable] = {"clearance": clearance, "friction": friction, "stiffness": stiffness,
                               "restitution": restitution, "drive": drive, "damping": damping, "mass": mass,
-                              "compliance": compliance, "port_area": port_area, "precharge": precharge,
+                              "compliance": compliance, "beam_stiffness": beam_stiffness,
+                              "contact_length": contact_length, "port_area": port_area, "precharge": precharge,
                               "bulk_modulus": bulk_modulus, "preload": preload, "dashpot": dashpot,
                               "gas_load": gas_load, "guide_friction": guide_friction}
 

@@ -204,18 +204,31 @@ def element_histories(system, times, states, out):
 
 
 @njit(cache=True)
+def element_stored_energy(system, k, q):
+    """U(s) = U_ref − ∫₀ˢ F ds of element k if it is a spring drive or a gas load; 0 for the others."""
+    kind = system.driveline_kinds[k, 0]
+    if kind != SPRING_DRIVE and kind != GAS_LOAD:
+        return 0.0
+    s = element_geometry(system, k, q, np.zeros_like(q))[0]
+    return system.driveline_params[k, DL_ENERGY] - stroke_force_and_work(system, k, s)[1]
+
+
+@njit(cache=True)
 def driveline_potential(system, q):
-    """Σ U(s) = U_ref − ∫₀ˢ F ds of the spring drives and gas loads."""
+    """Σ U(s) of the spring drives and gas loads."""
     energy = 0.0
-    if system.driveline_kinds.shape[0] == 0:
-        return energy
-    zero = np.zeros_like(q)
     for k in range(system.driveline_kinds.shape[0]):
-        kind = system.driveline_kinds[k, 0]
-        if kind == SPRING_DRIVE or kind == GAS_LOAD:
-            s = element_geometry(system, k, q, zero)[0]
-            energy += system.driveline_params[k, DL_ENERGY] - stroke_force_and_work(system, k, s)[1]
+        energy += element_stored_energy(system, k, q)
     return energy
+
+
+@njit(cache=True)
+def stored_energy_histories(system, states, out):
+    """U(s) of every element at every sample into out (S, elements); states (S, ≥ 2n)."""
+    n = 3 * system.mass.shape[0]
+    for i in range(states.shape[0]):
+        for k in range(system.driveline_kinds.shape[0]):
+            out[i, k] = element_stored_energy(system, k, states[i, :n])
 
 
 # --- build: the elements of a mechanism as arrays ---------------------------------------------------
@@ -377,6 +390,21 @@ def puffer_overrun(system, q: np.ndarray) -> tuple[str, str, str] | None:
                     "the motion compresses the gas further than `stroke:` says: check the drive's stroke, and the "
                     "puffer's volume, area and stroke and their units")
     return None
+
+
+STORED_ENERGY_NAMES = {SPRING_DRIVE: "drive_spring_stored", GAS_LOAD: "gas_stored"}
+
+
+def driveline_stored_energies(system, states: np.ndarray) -> dict:
+    """{energy name: Σ U(s) over the elements of that kind} of the spring drives (`drive_spring_stored`) and gas
+    loads (`gas_stored`), only for the kinds the model has; both are also part of the potential energy."""
+    kinds = system.arrays.driveline_kinds[:, 0]
+    present = [kind for kind in STORED_ENERGY_NAMES if np.any(kinds == kind)]
+    if not present:
+        return {}
+    values = np.empty((states.shape[0], kinds.shape[0]))
+    stored_energy_histories(for_kernels(system.arrays), np.ascontiguousarray(states), values)
+    return {STORED_ENERGY_NAMES[kind]: values[:, kinds == kind].sum(axis=1) for kind in present}
 
 
 def driveline_histories(system, times: np.ndarray, states: np.ndarray) -> dict:

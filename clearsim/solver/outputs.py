@@ -20,7 +20,7 @@ import numpy as np
 from clearsim.assembly.arrays import CL_CLEARANCE, CL_EXPONENT, CL_MIN_IMPACT_SPEED, CL_STIFFNESS, OFF_DIRECTION
 from clearsim.assembly.forces import STICK
 from clearsim.assembly import hydraulics
-from clearsim.assembly.drivelines import DASHPOT, GUIDE_FRICTION, driveline_histories
+from clearsim.assembly.drivelines import DASHPOT, GUIDE_FRICTION, driveline_histories, driveline_stored_energies
 from clearsim.assembly.dynamics import (
     WORK_APPLIED, WORK_CONTACT, WORK_COUNT, WORK_DAMPING, WORK_DASHPOT, WORK_DRIVER, WORK_FRICTION, WORK_GUIDE_FRICTION,
     WORK_OIL, WORK_ORIFICE, WORK_SUPPLY, WORK_TANK,
@@ -210,6 +210,7 @@ def energy_histories(system: System, chunk, initial_energy: float) -> dict:
         "damping_dissipated": work[:, WORK_DAMPING], "driver_work": work[:, WORK_DRIVER],
         "applied_work": work[:, WORK_APPLIED],
     } | {name: work[:, slot] for name, slot in driveline_dissipations(system).items()}
+    named |= driveline_stored_energies(system, chunk.states)  # parts of the potential: not in the balance again
     if system.hydraulic_cylinders:
         named |= {"hydraulic_supply_work": work[:, WORK_SUPPLY], "hydraulic_tank_work": work[:, WORK_TANK],
                   "orifice_dissipated": work[:, WORK_ORIFICE], "oil_compression": work[:, WORK_OIL]}

@@ -183,6 +183,33 @@ def test_adiabatic_puffer_compresses_as_p_v_gamma(simulate, gamma):
     assert_balance_closes(result, 1e-9)
 
 
+def test_spring_drive_and_puffer_stored_energies_are_written_apart_and_sum_to_the_potential(simulate):
+    """The block on its horizontal guide has no gravity energy: the potential is the spring's and the gas's."""
+    k, preload, p0, volume, area, gamma = 800.0, 100.0, 1e5, 1e-3, 1e-3, 1.4
+    result = simulate(block(f"{{name: spring, type: spring_drive, bodies: [ground, block], at: [W, O], "
+                            f"stiffness: {k} N/m, preload: {preload} N}}\n"
+                            f"  - {{name: puffer, type: gas_load, body: block, direction: [1, 0], area: {area} m^2, "
+                            f"volume: {volume * 1e3} L, initial_pressure: {p0} Pa, p_ambient: {p0} Pa, "
+                            f"gamma: {gamma}, stroke: 500 mm}}"))
+    s = result["sensors/x"]
+    assert s.max() > 0.05  # both elements work
+    spring = result["energy/drive_spring_stored"]
+    gas = result["energy/gas_stored"]
+    assert result["energy/potential"] == pytest.approx(spring + gas, rel=1e-12, abs=1e-15)
+    ratio = volume / (volume - area * s)
+    gas_work = p0 * volume / (gamma - 1) * (ratio ** (gamma - 1) - 1) - p0 * area * s
+    samples = np.linspace(0, len(s) - 1, 5).astype(int)
+    assert spring[samples] == pytest.approx(0.5 * k * (preload / k - s[samples]) ** 2, rel=1e-9)
+    assert gas[samples] == pytest.approx(gas_work[samples], rel=1e-9, abs=1e-15)
+    assert_balance_closes(result, 1e-9)  # counted once: inside the potential
+
+
+def test_a_model_without_spring_drive_or_gas_load_writes_no_stored_energy_entries(simulate):
+    result = simulate(block("{name: damper, type: dashpot, bodies: [ground, block], at: [W, O], sense: lengthening, "
+                            "damping: 4 N*s/m}", "1 m/s", "0.01 s"))
+    assert "energy/drive_spring_stored" not in result and "energy/gas_stored" not in result
+
+
 def test_pressure_table_gas_load_stores_its_integral(simulate):
     area, ambient = 2e-3, 1e5
     table = [(0.0, 1.0e5), (0.02, 1.5e5), (0.04, 3.0e5)]

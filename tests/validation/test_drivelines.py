@@ -364,9 +364,8 @@ DRIVE_LINE = [
 ]
 
 
-def test_the_breaker_driven_by_its_drive_line_closes_its_energy_balance(simulate):
-    """The bundled breaker without its prescribed drive: a closing spring, an end-of-stroke cushion, the puffer and
-    the contact fingers' friction, with the clearance joints A and J."""
+def breaker_driven_by_its_drive_line() -> str:
+    """The bundled breaker's YAML without its prescribed drive, driven by DRIVE_LINE over 120 ms."""
     import yaml
 
     from clearsim.runner import BUNDLED_CONFIG
@@ -375,7 +374,13 @@ def test_the_breaker_driven_by_its_drive_line_closes_its_energy_balance(simulate
     document["drivers"] = []
     document["forces"] = (document.get("forces") or []) + DRIVE_LINE
     document["solver"]["t_end"] = "120 ms"
-    result = simulate(yaml.safe_dump(document, sort_keys=False))
+    return yaml.safe_dump(document, sort_keys=False)
+
+
+def test_the_breaker_driven_by_its_drive_line_closes_its_energy_balance(simulate):
+    """The bundled breaker without its prescribed drive: a closing spring, an end-of-stroke cushion, the puffer and
+    the contact fingers' friction, with the clearance joints A and J."""
+    result = simulate(breaker_driven_by_its_drive_line())
     travel = result["sensors/contact_displacement"]
     assert 0.3 < travel[-1] < 0.4  # the spring closes the breaker, the cushion stops it
     for kind in ("dashpot_dissipated", "guide_friction_dissipated", "friction_dissipated"):

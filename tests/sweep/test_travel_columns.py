@@ -34,17 +34,22 @@ def sweep(tmp_path: Path, config: Path, name: str):
         return out, result.output, list(csv.DictReader(handle))
 
 
-def test_each_case_shows_its_travel_figures_and_whether_it_kept_to_the_envelope(tmp_path):
-    config = tmp_path / "sc_travel.yaml"
-    config.write_text(SLIDER_CRANK.read_text().replace("output: {", f"{TRAVEL}\noutput: {{", 1))
-    out, output, rows = sweep(tmp_path, config, "sweep")
-    assert [row["case"] for row in rows] == ["ideal", "clearance-0.5_mm"]
+def assert_rows_are_the_case_files_travel_figures(out: Path, rows: list[dict]):
+    """Each summary row's travel columns equal the `travel_figures` its case's result file stores."""
     for row in rows:
         with h5py.File(out / f"{row['case']}.h5") as f:
             stored = json.loads(f.attrs["travel_figures"])
         for column, (key, scale) in COLUMNS.items():
             assert float(row[column]) == pytest.approx(stored[key] * scale, rel=1e-12), (row["case"], column)
         assert row["inside_envelope"] == ("yes" if stored["inside_envelope"] else "no")
+
+
+def test_each_case_shows_its_travel_figures_and_whether_it_kept_to_the_envelope(tmp_path):
+    config = tmp_path / "sc_travel.yaml"
+    config.write_text(SLIDER_CRANK.read_text().replace("output: {", f"{TRAVEL}\noutput: {{", 1))
+    out, output, rows = sweep(tmp_path, config, "sweep")
+    assert [row["case"] for row in rows] == ["ideal", "clearance-0.5_mm"]
+    assert_rows_are_the_case_files_travel_figures(out, rows)
     assert rows[0]["inside_envelope"] == "no" and 0.0 < float(rows[0]["operating_time_ms"]) < 3.0
     header = next(line for line in output.splitlines() if "closing" in line)
     assert all(title in output for title in ("closing", "zone", "overtravel", "rebound", "envelope"))

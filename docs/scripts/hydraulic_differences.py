@@ -1,0 +1,96 @@
+"""Where A's start impact goes, prescribed stroke against hydraulic cylinder (docs/validation.md §6, "Force-driven
+breaker").
+
+Usage: python docs/scripts/hydraulic_differences.py OUT
+where OUT was written by
+    python docs/scripts/flexible_studies.py OUT --skip-friction \
+        --models prescribed=configs/uhv_breaker.yaml,hydraulic=configs/uhv_breaker_hydraulic.yaml
+
+Window: from A's first contact (first sample with F_n A > 0) to J's first contact (first sample with F_n J > 0).
+Printed per clearance and drive:
+- the driving link's momentum budget along the drive axis x over the window: its momentum change m Δv, the impulse
+  of A's contact force on it (normal and friction), the impulse of the drive's recorded force on it (the cylinder's;
+  for the prescribed stroke none is recorded: what is left is the driver's reaction);
+- J's first impact speed and the turn arm's angular velocity at J's first contact, A and J against J only, and the
+  output's largest |a| over the first 10 ms, A and J against J only.
+"""
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+DRIVING_LINK_MASS = 3.670  # kg, both files
+CLEARANCES = ("0.01", "0.03", "0.05", "0.1")
+MODELS = ("prescribed", "hydraulic")
+FIRST_MILLISECONDS = 0.010  # s
+
+
+def first_contact_index(normal_force):
+    return int(np.argmax(normal_force > 0))
+
+
+def contact_force_on_bearing_x(result):
+    """x-component of A's contact force on its bearing (the driving link): normal along the eccentricity
+    (journal centre − bearing centre), friction along its right-hand perpendicular (checked: m a_x = this − cylinder force, sample by sample)."""
+    eccentricity = result["joints/A/eccentricity"][:]
+    length = np.hypot(eccentricity[:, 0], eccentricity[:, 1])
+    safe_length = np.where(length > 0, length, 1.0)
+    normal_x = eccentricity[:, 0] / safe_length
+    tangent_x = eccentricity[:, 1] / safe_length
+    return result["joints/A/normal_force"][:] * normal_x + result["joints/A/friction_force"][:] * tangent_x
+
+
+def momentum_budget(path):
+    with h5py.File(path, "r") as result:
+        time = result["time"][:]
+        start = first_contact_index(result["joints/A/normal_force"][:])
+        stop = first_contact_index(result["joints/J/normal_force"][:])
+        window = slice(start - 1, stop + 1)
+        velocity = result["bodies/driving_link/qd"][:, 0]
+        contact_impulse = np.trapezoid(contact_force_on_bearing_x(result)[window], time[window])
+        drive_impulse = 0.0
+        if "drives/operating_cylinder/force" in result:  # recorded as the force on ground: the link feels −force
+            drive_impulse = -np.trapezoid(result["drives/operating_cylinder/force"][window], time[window])
+        return {
+            "window (ms)": f"{time[start - 1] * 1e3:.2f}-{time[stop] * 1e3:.2f}",
+            "v before (m/s)": velocity[start - 1],
+            "v after (m/s)": velocity[stop],
+            "m dv (N s)": DRIVING_LINK_MASS * (velocity[stop] - velocity[start - 1]),
+            "A impulse (N s)": contact_impulse,
+            "cylinder impulse (N s)": drive_impulse,
+        }
+
+
+def j_closing(path):
+    with h5py.File(path, "r") as result:
+        time = result["time"][:]
+        closing = first_contact_index(result["joints/J/normal_force"][:])
+        return {
+            "J impact speed (m/s)": result["joints/J/episodes/impact_speed"][0],
+            "turn arm omega (rad/s)": result["sensors/turn_arm_angular_velocity"][closing],
+            "output peak 0-10 ms (m/s^2)": np.abs(result["sensors/contact_acceleration"][time <= FIRST_MILLISECONDS]).max(),
+        }
+
+
+def formatted(row):
+    return ", ".join(f"{key} {value:+.3f}" if isinstance(value, float) else f"{key} {value}" for key, value in row.items())
+
+
+def main(out_directory):
+    out = Path(out_directory)
+    print("Driving link's momentum along x, A's first contact -> J's first contact (A and J cases):")
+    for clearance in CLEARANCES:
+        for model in MODELS:
+            print(f"  {clearance} mm {model}: {formatted(momentum_budget(out / f'{model}-A-and-J-{clearance}-mm.h5'))}")
+    print("J's first closing, A and J / J only:")
+    for clearance in CLEARANCES:
+        for model in MODELS:
+            both = j_closing(out / f"{model}-A-and-J-{clearance}-mm.h5")
+            j_only = j_closing(out / f"{model}-J-only-{clearance}-mm.h5")
+            ratios = {key: float(both[key] / j_only[key]) for key in both}
+            print(f"  {clearance} mm {model}: A and J {formatted(both)}; ratio to J only {formatted(ratios)}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])

@@ -12,7 +12,10 @@ Printed per clearance and drive:
   of A's contact force on it (normal and friction), the impulse of the drive's recorded force on it (the cylinder's;
   for the prescribed stroke none is recorded: what is left is the driver's reaction);
 - J's first impact speed and the turn arm's angular velocity at J's first contact, A and J against J only, and the
-  output's largest |a| over the first 10 ms, A and J against J only.
+  output's largest |a| over the first 10 ms, A and J against J only;
+- under the cylinder, the start delay (forward crossing of 1 % of the ideal's peak speed, as flexible_studies.py),
+  the delay predicted from the output's velocity deviation at the ideal's crossing, −(v − v_threshold)/a_ideal, and
+  the range of v − v_ideal within ±1 ms of the crossing.
 """
 import sys
 from pathlib import Path
@@ -20,10 +23,14 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from clearsim.sweep.figures import start_time
+
 DRIVING_LINK_MASS = 3.670  # kg, both files
 CLEARANCES = ("0.01", "0.03", "0.05", "0.1")
 MODELS = ("prescribed", "hydraulic")
 FIRST_MILLISECONDS = 0.010  # s
+DELAY_FRACTION = 0.01  # of the ideal's peak speed
+DEVIATION_WINDOW = 0.001  # s either side of the crossing
 
 
 def first_contact_index(normal_force):
@@ -73,6 +80,29 @@ def j_closing(path):
         }
 
 
+def start_delay_phase(path, ideal_path):
+    with h5py.File(ideal_path, "r") as ideal:
+        ideal_time = ideal["time"][:]
+        ideal_velocity = ideal["sensors/contact_velocity"][:]
+    threshold = DELAY_FRACTION * ideal_velocity.max()
+    ideal_crossing = start_time(ideal_time, ideal_velocity, threshold, 1.0)
+    ideal_acceleration = np.interp(ideal_crossing, ideal_time, np.gradient(ideal_velocity, ideal_time))
+    with h5py.File(path, "r") as result:
+        time = result["time"][:]
+        velocity = result["sensors/contact_velocity"][:]
+    crossing = start_time(time, velocity, threshold, 1.0)
+    near = np.abs(time - crossing) < DEVIATION_WINDOW
+    deviation = velocity[near] - np.interp(time[near], ideal_time, ideal_velocity)
+    return {
+        "crossing (ms)": crossing * 1e3,
+        "delay (ms)": (crossing - ideal_crossing) * 1e3,
+        "a_ideal (m/s^2)": ideal_acceleration,
+        "predicted (ms)": -(np.interp(ideal_crossing, time, velocity) - threshold) / ideal_acceleration * 1e3,
+        "v - v_ideal min (m/s)": deviation.min(),
+        "v - v_ideal max (m/s)": deviation.max(),
+    }
+
+
 def formatted(row):
     return ", ".join(f"{key} {value:+.3f}" if isinstance(value, float) else f"{key} {value}" for key, value in row.items())
 
@@ -90,6 +120,11 @@ def main(out_directory):
             j_only = j_closing(out / f"{model}-J-only-{clearance}-mm.h5")
             ratios = {key: float(both[key] / j_only[key]) for key in both}
             print(f"  {clearance} mm {model}: A and J {formatted(both)}; ratio to J only {formatted(ratios)}")
+    print("Start delay under the cylinder:")
+    for case in ("J-only", "A-and-J"):
+        for clearance in CLEARANCES:
+            row = start_delay_phase(out / f"hydraulic-{case}-{clearance}-mm.h5", out / "hydraulic-ideal.h5")
+            print(f"  {case} {clearance} mm: {formatted(row)}")
 
 
 if __name__ == "__main__":

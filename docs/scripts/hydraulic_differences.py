@@ -15,7 +15,9 @@ Printed per clearance and drive:
   output's largest |a| over the first 10 ms, A and J against J only;
 - under the cylinder, the start delay (forward crossing of 1 % of the ideal's peak speed, as flexible_studies.py),
   the delay predicted from the output's velocity deviation at the ideal's crossing, −(v − v_threshold)/a_ideal, and
-  the range of v − v_ideal within ±1 ms of the crossing.
+  the range of v − v_ideal within ±1 ms of the crossing;
+- under the cylinder, over the contact-zone window (the output from 200 to 250 mm): the output's, the driving
+  link's and the turn arm's mean speeds and the chambers' mean pressures, ideal against A and J at 0.1 mm.
 """
 import sys
 from pathlib import Path
@@ -31,6 +33,7 @@ MODELS = ("prescribed", "hydraulic")
 FIRST_MILLISECONDS = 0.010  # s
 DELAY_FRACTION = 0.01  # of the ideal's peak speed
 DEVIATION_WINDOW = 0.001  # s either side of the crossing
+SPEED_ZONE = (0.200, 0.250)  # m of output travel, the hydraulic file's travel: speed_zone
 
 
 def first_contact_index(normal_force):
@@ -103,6 +106,31 @@ def start_delay_phase(path, ideal_path):
     }
 
 
+def crossing_time(time, travel, level):
+    k = int(np.argmax(travel >= level))
+    return time[k - 1] + (level - travel[k - 1]) / (travel[k] - travel[k - 1]) * (time[k] - time[k - 1])
+
+
+def zone_means(path):
+    with h5py.File(path, "r") as result:
+        time = result["time"][:]
+        travel = result["sensors/contact_displacement"][:] - result["sensors/contact_displacement"][0]
+        enter, leave = (crossing_time(time, travel, level) for level in SPEED_ZONE)
+        zone = (time >= enter) & (time <= leave)
+        link_position = result["bodies/driving_link/q"][:, 0]
+        cylinder = result["drives/operating_cylinder"]
+        return {
+            "zone (ms)": f"{enter * 1e3:.3f}-{leave * 1e3:.3f}",
+            "output (m/s)": (SPEED_ZONE[1] - SPEED_ZONE[0]) / (leave - enter),
+            "driving link (m/s)": abs(np.interp(leave, time, link_position) - np.interp(enter, time, link_position))
+            / (leave - enter),
+            "turn arm (rad/s)": result["sensors/turn_arm_angular_velocity"][zone].mean(),
+            "supply (bar)": cylinder["supply_pressure"][zone].mean() / 1e5,
+            "piston chamber (bar)": cylinder["piston_pressure"][zone].mean() / 1e5,
+            "rod chamber (bar)": cylinder["rod_pressure"][zone].mean() / 1e5,
+        }
+
+
 def formatted(row):
     return ", ".join(f"{key} {value:+.3f}" if isinstance(value, float) else f"{key} {value}" for key, value in row.items())
 
@@ -125,6 +153,9 @@ def main(out_directory):
         for clearance in CLEARANCES:
             row = start_delay_phase(out / f"hydraulic-{case}-{clearance}-mm.h5", out / "hydraulic-ideal.h5")
             print(f"  {case} {clearance} mm: {formatted(row)}")
+    print("Contact zone under the cylinder:")
+    for case in ("hydraulic-ideal", "hydraulic-A-and-J-0.1-mm"):
+        print(f"  {case}: {formatted(zone_means(out / f'{case}.h5'))}")
 
 
 if __name__ == "__main__":

@@ -216,7 +216,8 @@ def run(
 ) -> None:
     """Simulate a mechanism and write its time histories to an HDF5 file."""
     from clearsim.io.hdf5 import ResultWriteError
-    from clearsim.runner import BUNDLED_CONFIG, check_output_path, prepare, run_to_file, summarize, written_line
+    from clearsim.runner import (BUNDLED_CONFIG, check_output_path, prepare, read_where_it_is, run_to_file, summarize,
+                                 written_line)
     from clearsim.model.loader import load_mechanism
 
     check_output_path(output, config or BUNDLED_CONFIG)
@@ -233,8 +234,8 @@ def run(
     if isinstance(report.error, ResultWriteError):
         raise report.error  # the file may not even be readable: nothing to summarise
     console.print(f"[bold]{system.mechanism.name}[/]: {report.status} → {report.output}")
-    console.print(written_line(report.output), highlight=False, soft_wrap=True)
-    summary = summarize(report.output)
+    console.print(read_where_it_is(report, written_line), highlight=False, soft_wrap=True)
+    summary = read_where_it_is(report, summarize)
     console.print(_summary_table(report, summary))
     for line in summary.flexible_modes:
         console.print(line, highlight=False, soft_wrap=True)

@@ -25,8 +25,8 @@ from clearsim.assembly.system import System, assemble
 from clearsim.errors import ClearsimError, InputError, SolverError, format_path
 from clearsim.io.files import adopt_abandoned, locate, partial_name, publish, same_file
 from clearsim.io.hdf5 import (
-    CHUNK_ROWS, ResultWriteError, ResultWriter, check_free_space, group_attribute, interrupts_deferred, read_result,
-    result_overview, write_failure,
+    CHUNK_ROWS, NotAResultFile, ResultWriteError, ResultWriter, check_free_space, group_attribute, interrupts_deferred,
+    read_result, result_overview, write_failure,
 )
 from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
 from clearsim.model.flexible import flexible_link_names
@@ -424,6 +424,19 @@ def _frequency(hertz: float) -> str:
         if hertz >= scale:
             return f"{hertz / scale:.4g} {unit}"
     return f"{hertz:.4g} Hz"
+
+
+def read_where_it_is(report, read: Callable[[Path], object]):
+    """read(path) of a run's published file; when a later run with the same output name moves it aside between
+    finding it and opening it (`report.output` locates it each time), read it once more where it is now."""
+    path = report.output
+    try:
+        return read(path)
+    except (OSError, NotAResultFile):
+        moved = report.output
+        if moved == path:
+            raise
+        return read(moved)
 
 
 def written_line(path: Path) -> str:

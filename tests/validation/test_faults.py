@@ -244,6 +244,30 @@ def test_runs_on_one_output_both_keep_their_result(tmp_path, locking, meeting):
     assert len(kept) == 2, kept
 
 
+def test_a_result_moved_aside_between_finding_and_opening_it_is_read_where_it_went(tmp_path):
+    """A later run with the same output name renamed the file after `report.output` found it and before it was
+    opened (seen once as exit 1 in the two-runs test above): it is read once more where it is now."""
+    from clearsim.runner import read_where_it_is
+
+    out, aside = tmp_path / "sc.h5", tmp_path / "sc.previous.h5"
+    aside.write_text("the run's result")
+
+    class Report:  # `output` found the file at `out`, then the other run moved it
+        places = iter([out, aside])
+
+        @property
+        def output(self):
+            return next(self.places)
+
+    assert read_where_it_is(Report(), lambda path: path.read_text()) == "the run's result"
+
+    class Unmoved:
+        output = out  # missing, and still where it was looked for: the error is not hidden
+
+    with pytest.raises(FileNotFoundError):
+        read_where_it_is(Unmoved(), lambda path: path.read_text())
+
+
 def test_a_published_file_is_found_where_a_later_one_with_its_name_moved_it(tmp_path):
     out = tmp_path / "run.h5"
     first, second = partial_name(out), partial_name(out)

@@ -17,7 +17,11 @@ Printed per clearance and drive:
   the delay predicted from the output's velocity deviation at the ideal's crossing, −(v − v_threshold)/a_ideal, and
   the range of v − v_ideal within ±1 ms of the crossing;
 - under the cylinder, over the contact-zone window (the output from 200 to 250 mm): the output's, the driving
-  link's and the turn arm's mean speeds and the chambers' mean pressures, ideal against A and J at 0.1 mm.
+  link's and the turn arm's mean speeds and the chambers' mean pressures, ideal against A and J at 0.1 mm;
+- under the cylinder, where that difference comes from (zone_transient): when the cylinder's net force on the link
+  first changes sign (the load reversal at A) and A's free flights after it, the output's speed against the ideal's
+  at the same travel along the stroke, the zone's mean speed for windows shifted by ±10 mm, and the kinetic-energy
+  change, the cylinder's work and the friction work over the zone.
 """
 import sys
 from pathlib import Path
@@ -34,6 +38,7 @@ FIRST_MILLISECONDS = 0.010  # s
 DELAY_FRACTION = 0.01  # of the ideal's peak speed
 DEVIATION_WINDOW = 0.001  # s either side of the crossing
 SPEED_ZONE = (0.200, 0.250)  # m of output travel, the hydraulic file's travel: speed_zone
+AFTER_START = 0.020  # s: past the start's pull-back, where the cylinder's force also changes sign
 
 
 def first_contact_index(normal_force):
@@ -131,6 +136,61 @@ def zone_means(path):
         }
 
 
+def _zone_energies(time, travel, result):
+    """Kinetic-energy change, cylinder work and joint-friction work over the contact zone (J)."""
+    enter, leave = (int(np.argmax(travel >= level)) for level in SPEED_ZONE)
+    cylinder = result["drives/operating_cylinder"]
+    window = slice(enter, leave + 1)
+    kinetic = result["energy/kinetic"][:]
+    friction = result["energy/friction_dissipated"][:]
+    return {"kinetic change (J)": kinetic[leave] - kinetic[enter],
+            "cylinder work (J)": float(np.trapezoid(cylinder["force"][window], cylinder["stroke"][window])),
+            "friction work (J)": friction[leave] - friction[enter]}
+
+
+def load_reversal(time, travel, force):
+    """Index of the first sign change of the cylinder's net force after the start, before the contact's 299 mm."""
+    after_start = time > AFTER_START
+    pushing = np.sign(force[int(np.argmax(after_start))])
+    return int(np.argmax((time < crossing_time(time, travel, 0.299)) & after_start & (np.sign(force) != pushing)))
+
+
+def zone_transient(path, ideal_path):
+    """The load reversal at A and the output's speed along the stroke against the ideal's (at equal travel)."""
+    with h5py.File(ideal_path, "r") as ideal:
+        ideal_time = ideal["time"][:]
+        ideal_travel = ideal["sensors/contact_displacement"][:]
+        ideal_speed = ideal["sensors/contact_velocity"][:]
+        ideal_energies = _zone_energies(ideal_time, ideal_travel, ideal)
+        ideal_reversal = ideal_time[load_reversal(ideal_time, ideal_travel, ideal["drives/operating_cylinder/force"][:])]
+    with h5py.File(path, "r") as result:
+        time = result["time"][:]
+        travel = result["sensors/contact_displacement"][:]
+        speed = result["sensors/contact_velocity"][:]
+        force = result["drives/operating_cylinder/force"][:]
+        free_at_a = result["joints/A/mode"][:] == 0
+        energies = _zone_energies(time, travel, result)
+    stroke = time < crossing_time(time, travel, 0.299)
+    reversal = load_reversal(time, travel, force)
+    flights = np.flatnonzero(free_at_a & (time > time[reversal]) & (travel < SPEED_ZONE[1]))
+    row = {"ideal's reversal (ms)": ideal_reversal * 1e3, "reversal at A (ms)": time[reversal] * 1e3, "output there (mm)": travel[reversal] * 1e3,
+           "A's free flights (ms)": f"{time[flights[0]] * 1e3:.2f}-{time[flights[-1]] * 1e3:.2f}" if flights.size else "none",
+           "output there (mm) ": f"{travel[flights[0]] * 1e3:.0f}-{travel[flights[-1]] * 1e3:.0f}" if flights.size else "-"}
+    ideal_stroke = ideal_time < crossing_time(ideal_time, ideal_travel, 0.299)
+    for level in np.arange(0.170, 0.271, 0.010):
+        ratio = (np.interp(level, travel[stroke], speed[stroke])
+                 / np.interp(level, ideal_travel[ideal_stroke], ideal_speed[ideal_stroke]) - 1.0)
+        row[f"speed at {level * 1e3:.0f} mm (%)"] = ratio * 100.0
+    for shift in (-0.010, 0.0, 0.010):
+        low, high = SPEED_ZONE[0] + shift, SPEED_ZONE[1] + shift
+        duration = crossing_time(time, travel, high) - crossing_time(time, travel, low)
+        ideal_duration = (crossing_time(ideal_time, ideal_travel, high)
+                          - crossing_time(ideal_time, ideal_travel, low))
+        row[f"zone {low * 1e3:.0f}-{high * 1e3:.0f} mm speed (%)"] = (ideal_duration / duration - 1.0) * 100.0
+    row.update({f"{key}, difference": energies[key] - ideal_energies[key] for key in energies})
+    return row
+
+
 def formatted(row):
     return ", ".join(f"{key} {value:+.3f}" if isinstance(value, float) else f"{key} {value}" for key, value in row.items())
 
@@ -156,6 +216,8 @@ def main(out_directory):
     print("Contact zone under the cylinder:")
     for case in ("hydraulic-ideal", "hydraulic-A-and-J-0.1-mm"):
         print(f"  {case}: {formatted(zone_means(out / f'{case}.h5'))}")
+    print("Where the zone's difference comes from, A and J at 0.1 mm against the ideal:")
+    print(f"  {formatted(zone_transient(out / 'hydraulic-A-and-J-0.1-mm.h5', out / 'hydraulic-ideal.h5'))}")
 
 
 if __name__ == "__main__":

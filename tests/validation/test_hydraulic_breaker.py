@@ -80,3 +80,37 @@ def test_the_travel_figures_are_in_the_run_summary(hydraulic_run):
     assert travel["total_travel_m"] == pytest.approx(contact[-1] - contact[0], abs=1e-12)  # clearsim: 303.1 mm
     assert travel["damping_duration_s"] is not None
     assert travel["inside_envelope"] is True
+
+
+def prescribed_stroke_run(folder, loads):
+    """The hydraulic file with its cylinder replaced by the bundled file's stroke law (eq. 16), keeping the moving
+    contact's `loads`, A and J at 0.01 mm, over 55 ms."""
+    document = yaml.safe_load(HYDRAULIC_CONFIG.read_text())
+    document["forces"] = [force for force in document["forces"] if force["name"] in loads]
+    document["drivers"] = yaml.safe_load(BUNDLED_CONFIG.read_text())["drivers"]
+    document["solver"]["t_end"] = "55 ms"
+    if not document["forces"]:
+        del document["forces"]
+    config = folder / f"stroke-law-{'-'.join(loads) or 'no-loads'}.yaml"
+    config.write_text(yaml.safe_dump(document, sort_keys=False))
+    loaded = load_mechanism(config, ())
+    report = run_to_file(prepare(loaded), loaded, config.with_suffix(".h5"))
+    assert report.complete, report.status
+    return read_result(config.with_suffix(".h5"))
+
+
+@pytest.mark.slow
+def test_the_gas_load_keeps_j_on_its_wall_and_stops_the_whirl(tmp_path):
+    """docs/validation.md §6, "Force-driven breaker": under the prescribed stroke, A's load reversal at mid-stroke
+    unloads J, whose journal then rolls round its bore (the whirl, −21 turns in 45–55 ms); the puffer's gas load presses
+    the moving contact against its stroke, J keeps ≥ 448 N through A's hits and does not whirl. Two 55 ms runs."""
+    from tests.validation.test_paper_trends import orbit_turns
+
+    mid_stroke = slice(3500, 5000)  # 35-50 ms at the file's 100 kHz
+    without, with_gas = (prescribed_stroke_run(tmp_path, loads) for loads in ((), ("puffer_gas",)))
+    whirling, rolling = orbit_turns(without)
+    assert whirling < -10.0 and whirling == pytest.approx(rolling, rel=0.10), (whirling, rolling)
+    assert without["joints/J/normal_force"][mid_stroke].min() == 0.0  # J leaves its wall (42.6 ms)
+    held, rolling_with_gas = orbit_turns(with_gas)
+    assert abs(held) < 2.0 and rolling_with_gas < -10.0, (held, rolling_with_gas)  # clearsim: 0.08 turns, rolling −26.9
+    assert with_gas["joints/J/normal_force"][mid_stroke].min() > 300.0  # clearsim: 448 N

@@ -269,8 +269,17 @@ def sensor_value(system: System, spec: SensorSpec, chunk, joint_outputs: dict, o
     return joint_force_component(spec, joint_outputs), "N"
 
 
+def eccentricity_frame(eccentricity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n, t) per sample: n = e/|e| from the bearing centre to the journal's, t = n turned by +90°; a centred journal
+    takes n = x, as the solver does (assembly/forces.clearance_kinematics)."""
+    length = np.linalg.norm(eccentricity, axis=1, keepdims=True)
+    normal = np.where(length > 1e-300, eccentricity / np.maximum(length, 1e-300), [1.0, 0.0])
+    return normal, np.stack([-normal[:, 1], normal[:, 0]], axis=1)
+
+
 def joint_force_component(spec: SensorSpec, joint_outputs: dict) -> np.ndarray:
-    """A joint's force component; an ideal joint's 'normal' force is its reaction magnitude, its friction 0."""
+    """A joint's force component; an ideal joint's 'normal' force is its reaction magnitude, its friction 0; a
+    lubricated joint's x, y and magnitude include its oil film's force, its normal and friction are the dry contact's."""
     prefix = f"joints/{spec.joint}/"
     if spec.component in ("normal", "friction") and prefix + "normal_force" in joint_outputs:
         return joint_outputs[prefix + f"{spec.component}_force"][0]
@@ -280,12 +289,13 @@ def joint_force_component(spec: SensorSpec, joint_outputs: dict) -> np.ndarray:
             return np.zeros(len(force))
         if spec.component == "normal":
             return np.linalg.norm(force, axis=1)
-    else:  # clearance joint: the contact force on the journal in global components
-        ecc = joint_outputs[prefix + "eccentricity"][0]
-        normal = ecc / np.maximum(np.linalg.norm(ecc, axis=1, keepdims=True), 1e-300)
-        tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
+    else:  # clearance joint: the contact force on the journal in global components, and a lubricated joint's film
+        normal, tangent = eccentricity_frame(joint_outputs[prefix + "eccentricity"][0])
         force = (-joint_outputs[prefix + "normal_force"][0][:, None] * normal
                  + joint_outputs[prefix + "friction_force"][0][:, None] * tangent)
+        if prefix + "film_force" in joint_outputs:
+            film = joint_outputs[prefix + "film_force"][0]
+            force = force + film[:, :1] * normal + film[:, 1:] * tangent
     if spec.component == "x":
         return force[:, 0]
     if spec.component == "y":

@@ -246,3 +246,21 @@ def test_the_recorded_regime_switches_at_the_contact_events(simulate):
 def test_a_dry_joint_writes_no_film_datasets(simulate):
     result = simulate(journal(10.0, 1.0).replace(", lubrication: {viscosity: 0.05 Pa*s, length: 10 mm}", ""))
     assert "joints/O/normal_force" in result and not any("/film_" in name for name in result)
+
+
+PIN_SENSORS = """sensors:
+  - {name: pin_load, type: joint_force, joint: O}
+  - {name: pin_x, type: joint_force, joint: O, component: x}
+  - {name: pin_y, type: joint_force, joint: O, component: y}
+"""
+
+
+def test_a_joint_force_sensor_on_a_lubricated_joint_measures_the_film_force_too(simulate):
+    """The force in a lubricated joint is the film's while it carries the journal: the settled Ocvirk journal's pin
+    force sensor reads its 966 N load, and its x, y components are the recorded film force's."""
+    load = 966.0
+    result = simulate(journal(load, 30.0, spin=2000.0) + PIN_SENSORS)
+    assert result["sensors/pin_load"][-1] == pytest.approx(load, rel=1e-6)
+    force = film_force_global(result)
+    np.testing.assert_allclose(np.stack([result["sensors/pin_x"], result["sensors/pin_y"]], axis=1), force,
+                               rtol=0, atol=1e-9 * load)

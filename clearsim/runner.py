@@ -21,6 +21,8 @@ from clearsim.assembly.arrays import (
     CL_CLEARANCE, CL_DRY_GAP, CL_FILM_LENGTH, CL_JOURNAL_RADIUS, CL_STIFFNESS, CL_VISCOSITY, LAW_FILM_MODEL,
 )
 from clearsim.assembly.build import BuildError
+from clearsim.assembly.drivelines import STORED_ENERGY_NAMES
+from clearsim.assembly.hydraulics import HY_GAS_VOLUME
 from clearsim.assembly.system import System, assemble
 from clearsim.errors import ClearsimError, InputError, SolverError, format_path
 from clearsim.io.files import adopt_abandoned, locate, partial_name, publish, same_file
@@ -259,25 +261,48 @@ def element_place(loaded: LoadedMechanism, element: str | None) -> str:
     return f"{at}  {format_path(path, loaded.source.names)}"
 
 
-def result_file_bytes(system: System, contents: str = "all") -> float:
-    """An upper estimate of the result file's size: the datasets of the result layout that `contents` keeps, uncompressed
-    (8 bytes a value where the file keeps full precision, 4 elsewhere), in whole chunks of CHUNK_ROWS samples (a short
-    run's file holds one whole chunk of every dataset), 20 % over."""
-    samples = math.ceil((system.mechanism.solver.t_end * output_rate(system) + 1) / CHUNK_ROWS) * CHUNK_ROWS
+BASE_ENERGIES = 8  # kinetic, potential, contact/friction/damping dissipated, driver and applied work, balance error
+HYDRAULIC_ENERGIES = 4  # hydraulic_supply_work, hydraulic_tank_work, orifice_dissipated, oil_compression
+CYLINDER_VALUES, ACCUMULATOR_VALUES = 4, 2  # /drives/<cylinder>/: pressures, stroke, force; gas volume, supply pressure
+DRIVELINE_VALUES = 2  # /drives/<element>/: stroke (or sliding_velocity) and force
+
+
+def result_values(system: System) -> dict[str, int]:
+    """A dataset of each kind of the result layout → its values per sample over the model's elements (int8
+    datasets counted as 4-byte ones)."""
+    arrays = system.arrays
     bodies, clearances = len(system.body_names), len(system.clearance_joints)
-    values = {  # a dataset of each kind → values per sample of the kind
+    lubricated = int(np.count_nonzero(arrays.clearance_params[:, CL_VISCOSITY] > 0.0))
+    stored = set(arrays.driveline_kinds[:, 0].tolist()) & STORED_ENERGY_NAMES.keys()
+    accumulators = int(np.count_nonzero(arrays.hydraulic_params[:, HY_GAS_VOLUME] > 0.0))
+    return {
         "time": 1,
         "bodies/b/q": 3 * bodies, "bodies/b/qd": 6 * bodies,
         "joints/j/reaction": 2 * (len(system.pin_joints) + len(system.prismatic_joints)),
-        "joints/j/eccentricity": 5 * clearances, "joints/j/sliding_velocity": 3 * clearances,
+        "joints/j/eccentricity": 5 * clearances, "joints/j/sliding_velocity": 4 * clearances,
+        "joints/j/film_force": 2 * lubricated, "joints/j/film_thickness": 2 * lubricated,
         "drivers/d/effort": len(system.drivers),
         "sensors/s": len(system.sensors),
-        "forces/f/force": 2 * len(system.arrays.driveline_kinds),
-        "energy/e": 9 + len(driveline_dissipations(system)),
+        "drives/d/force": (CYLINDER_VALUES * len(system.hydraulic_cylinders) + ACCUMULATOR_VALUES * accumulators
+                           + DRIVELINE_VALUES * len(arrays.driveline_kinds)),
+        "energy/e": (BASE_ENERGIES + len(driveline_dissipations(system)) + len(stored)
+                     + HYDRAULIC_ENERGIES * bool(system.hydraulic_cylinders)),
+        "constraints/violation": 1,
     }
-    per_sample = sum(count * (8 if full_precision(name) else 4) for name, count in values.items()
-                     if name == "time" or CONTENTS[contents](name))
-    return 1.2 * per_sample * samples + 2**20
+
+
+def result_sample_bytes(system: System, contents: str = "all") -> int:
+    """Bytes a sample of the datasets `contents` keeps takes uncompressed: 8 a value where the file keeps full
+    precision, 4 elsewhere (result_values)."""
+    return sum(count * (8 if full_precision(name) else 4) for name, count in result_values(system).items()
+               if name == "time" or CONTENTS[contents](name))
+
+
+def result_file_bytes(system: System, contents: str = "all") -> float:
+    """An upper estimate of the result file's size: result_sample_bytes in whole chunks of CHUNK_ROWS samples (a short
+    run's file holds one whole chunk of every dataset), 20 % over, and 1 MiB for the attributes and episode tables."""
+    samples = math.ceil((system.mechanism.solver.t_end * output_rate(system) + 1) / CHUNK_ROWS) * CHUNK_ROWS
+    return 1.2 * result_sample_bytes(system, contents) * samples + 2**20
 
 
 FLUSH_SECONDS = 0.5

@@ -162,14 +162,23 @@ def film_state(system, k, q, qd):
 
 
 @njit(cache=True)
-def add_film_forces(system, k, q, qd, generalized):
-    """Add the oil film's force and torque on the journal of joint k (the opposite on the bearing, at the same
-    point P_J); return the power the film takes out, −F·(v_J − v_B)(P_J) − T (ω_J − ω_B)."""
+def film_forces(system, k, q, qd):
+    """(F_n, F_t, T, ω_J − ω_B) of the oil film of lubricated joint k on its journal: the force along (n, t) in N
+    and the torque in N·m (physics/lubrication.py)."""
     p = system.clearance_params[k]
     eps, eps_rate, wedge, spin = film_state(system, k, q, qd)
     fn, ft = film_force(system.clearance_laws[k, LAW_FILM_MODEL], p[CL_VISCOSITY], p[CL_JOURNAL_RADIUS],
                         p[CL_FILM_LENGTH], p[CL_CLEARANCE], eps, eps_rate, wedge)
     torque = film_torque(p[CL_VISCOSITY], p[CL_JOURNAL_RADIUS], p[CL_FILM_LENGTH], p[CL_CLEARANCE], eps, spin)
+    return fn, ft, torque, spin
+
+
+@njit(cache=True)
+def add_film_forces(system, k, q, qd, generalized):
+    """Add the oil film's force and torque on the journal of joint k (the opposite on the bearing, at the same
+    point P_J); return the power the film takes out, −F·(v_J − v_B)(P_J) − T (ω_J − ω_B)."""
+    p = system.clearance_params[k]
+    fn, ft, torque, spin = film_forces(system, k, q, qd)
     ex, ey, dex, dey, _, _, nx, ny, _ = clearance_kinematics(system, k, q, qd)
     fx = fn * nx - ft * ny
     fy = fn * ny + ft * nx

@@ -16,6 +16,7 @@ from clearsim.plot.style import (LEGEND_WIDTH, axes_or_new, legend_beside, new_f
 ENERGY_KINDS = ("kinetic", "potential", "driver_work", "applied_work", "contact_dissipated",
                 "friction_dissipated", "damping_dissipated", "hydraulic_supply_work", "hydraulic_tank_work",
                 "orifice_dissipated", "oil_compression", "dashpot_dissipated", "guide_friction_dissipated")
+STORED_SUFFIX = "_stored"  # energy held by a drive element (drive_spring_stored, gas_stored): counted in the potential
 VIOLATION_FLOOR = 1e-18  # m: stands for an exact zero on the logarithmic axis
 SPECTRUM_RANGE = 1e-8  # amplitudes below the highest peak × this are numerical floor (of an ideal run): not shown
 SPECTRUM_FLOOR_PERCENTILE = 1.0  # the amplitude axis starts at a third of this percentile of the clearance runs
@@ -128,19 +129,32 @@ def spectrum_figure(runs: list[RunData], sensors: list[str], interactive: bool =
     return figure
 
 
+def energy_entries(run: RunData) -> list[str]:
+    """Every /energy entry of the file but the balance error (drawn on its own): ENERGY_KINDS first, in their order,
+    then the others (the stored energies of drive elements, ...) as the file lists them."""
+    held = [key.split("/", 1)[1] for key in run.datasets if key.startswith("energy/")]
+    known = [kind for kind in ENERGY_KINDS if kind in held]
+    return known + [kind for kind in held if kind not in known and kind != "balance_error"]
+
+
+def energy_label(kind: str, values: np.ndarray) -> str:
+    """Legend label of an energy entry: its name; a stored energy (part of the potential, not in the balance again)
+    says so; one that stays 0 says so."""
+    label = "potential (change)" if kind == "potential" else pretty(kind)
+    if kind.endswith(STORED_SUFFIX):
+        label += " (part of potential)"
+    return label + (" (0 throughout)" if not np.any(values) else "")
+
+
 def plot_energies(run: RunData, ax=None):
-    """Kinetic energy, change of potential energy, works and dissipations (J) against time."""
+    """Every energy entry of the file (J) against time, each with its label: kinetic energy, change of potential
+    energy, works, dissipations and the energies stored in drive elements (energy_entries)."""
     ax = axes_or_new(ax)
-    for kind in ENERGY_KINDS:
-        key = f"energy/{kind}"
-        if not run.has(key):
-            continue
-        values = run.series(key)
-        if not np.any(values):
-            continue
-        label = pretty(kind)
+    for kind in energy_entries(run):
+        values = run.series(f"energy/{kind}")
+        label = energy_label(kind, values)
         if kind == "potential":
-            values, label = values - values[0], "potential (change)"
+            values = values - values[0]
         ax.plot(TIME(run.time), values, label=label)
     ax.set_ylabel("energy (J)")
     ax.set_xlabel(TIME.label("time"))

@@ -90,9 +90,30 @@ def _plot_force(runs: list[RunData], joint: str, dataset: str, label: str, ax):
     return ax
 
 
+FILM_GID = "film-force"  # lets tests and callers find the drawn film forces
+
+
+def film_force_magnitude(run: RunData, joint: str) -> np.ndarray:
+    """|F| of a lubricated joint's oil film force on the journal (`/joints/<j>/film_force`, 0 while dry)."""
+    return np.hypot(*run.series(f"joints/{joint}/film_force").T)
+
+
 def plot_contact_forces(runs: list[RunData], joint: str, ax=None):
-    """Normal force F_n (≥ 0, on the journal along −n) against time."""
-    return _plot_force(runs, joint, "normal_force", "normal force $F_n$", ax)
+    """Normal force F_n (≥ 0, on the journal along −n) against time; for a lubricated joint also its oil film
+    force |F_film| (dotted), which acts while F_n is zero (docs/model-contact.md, lubricated joints)."""
+    ax = axes_or_new(ax)
+    lubricated = [run for run in runs if run.has(f"joints/{joint}/film_force")]
+    films = [film_force_magnitude(run, joint) for run in lubricated]
+    scale = force_scale(np.concatenate([run.series(f"joints/{joint}/normal_force") for run in runs] + films))
+    _plot_joint_series(runs, joint, "normal_force", scale, ax)
+    peaks = [float(np.max(values, initial=0.0)) for values in films]
+    for run, values, style in zip(lubricated, films, overlay_styles(lubricated, peaks)):
+        ax.plot(TIME(run.time), scale(values), label=f"{run.label or run.name}: oil film", gid=FILM_GID,
+                **style | {"linestyle": ":"})
+    if lubricated and len(runs) == 1:
+        ax.legend(["dry contact $F_n$", "oil film $|F_{film}|$"], fontsize=8, loc="upper right")
+    ax.set_ylabel(scale.label("normal force $F_n$" + (", film $|F_{film}|$" if lubricated else "")))
+    return ax
 
 
 def plot_friction_force(runs: list[RunData], joint: str, ax=None):

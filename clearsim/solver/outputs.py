@@ -17,7 +17,9 @@ import math
 
 import numpy as np
 
-from clearsim.assembly.arrays import CL_CLEARANCE, CL_EXPONENT, CL_MIN_IMPACT_SPEED, CL_STIFFNESS, OFF_DIRECTION
+from clearsim.assembly.arrays import (
+    CL_CLEARANCE, CL_EXPONENT, CL_MIN_IMPACT_SPEED, CL_STIFFNESS, CL_VISCOSITY, OFF_DIRECTION,
+)
 from clearsim.assembly.forces import STICK
 from clearsim.assembly import hydraulics
 from clearsim.assembly.drivelines import DASHPOT, GUIDE_FRICTION, driveline_histories, driveline_stored_energies
@@ -29,7 +31,10 @@ from clearsim.assembly.system import SensorSpec, System
 from clearsim.model import schema
 from clearsim.physics.cylindrical import POWER_LAW_CODES, max_penetrations
 from clearsim.units import UnitError, to_si
-from clearsim.solver.samples import C_ECC_X, C_ECC_Y, C_FRICTION, C_NORMAL, C_PENETRATION, C_RATE, C_SLIDING
+from clearsim.solver.samples import (
+    C_ECC_X, C_ECC_Y, C_FILM_ACTIVE, C_FILM_RADIAL, C_FILM_TANGENTIAL, C_FILM_THICKNESS, C_FRICTION, C_NORMAL,
+    C_PENETRATION, C_RATE, C_SLIDING,
+)
 
 FREE_FLIGHT, IMPACT, CONTINUOUS_CONTACT = 0, 1, 2
 IMPACT_DURATION_FACTOR = 3.0
@@ -42,7 +47,7 @@ REFERENCE_IMPACT_SPEED = 1.0  # m/s: the impact speed of the t_c estimate (t_c �
 LOWEST_DEFAULT_RATE, HIGHEST_DEFAULT_RATE = 1e3, 1e5  # Hz
 
 # datasets a user needs to full precision (docs/model.md §8); every other floating-point history is stored as float32
-FULL_PRECISION_SUFFIXES = ("/q", "/eccentricity", "/penetration", "/normal_force", "/friction_force")
+FULL_PRECISION_SUFFIXES = ("/q", "/eccentricity", "/penetration", "/normal_force", "/friction_force", "/film_force")
 FULL_PRECISION_GROUPS = ("sensors/", "energy/", "drives/")
 
 COORDINATE_UNITS = {"q": "m, m, rad", "qd": "m/s, m/s, rad/s", "qdd": "m/s^2, m/s^2, rad/s^2"}
@@ -190,7 +195,17 @@ def clearance_histories(system: System, chunk, modes: np.ndarray) -> dict:
         out[f"joints/{name}/sliding_velocity"] = (contact[:, C_SLIDING], "m/s")
         out[f"joints/{name}/mode"] = (modes[:, k], "0 free, 1 impact, 2 contact")
         out[f"joints/{name}/stick"] = ((chunk.modes[:, k] == STICK).astype(np.int8), "1 sticking (v_t = 0), 0 not")
+        if system.arrays.clearance_params[k, CL_VISCOSITY] > 0.0:
+            out |= film_histories(name, contact)
     return out
+
+
+def film_histories(joint: str, contact: np.ndarray) -> dict:
+    """The oil film of a lubricated joint from its (S, CONTACT_FIELDS) contact fields: its force on the journal along
+    (n, t) of the eccentricity frame (zero while the dry laws act), the thinnest film c − |e|, and which acts."""
+    return {f"joints/{joint}/film_force": (contact[:, [C_FILM_RADIAL, C_FILM_TANGENTIAL]], "N"),
+            f"joints/{joint}/film_thickness": (contact[:, C_FILM_THICKNESS], "m"),
+            f"joints/{joint}/film_active": (contact[:, C_FILM_ACTIVE].astype(np.int8), "1 film acts, 0 dry contact laws")}
 
 
 def driveline_dissipations(system: System) -> dict[str, int]:
@@ -254,8 +269,17 @@ def sensor_value(system: System, spec: SensorSpec, chunk, joint_outputs: dict, o
     return joint_force_component(spec, joint_outputs), "N"
 
 
+def eccentricity_frame(eccentricity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n, t) per sample: n = e/|e| from the bearing centre to the journal's, t = n turned by +90°; a centred journal
+    takes n = x, as the solver does (assembly/forces.clearance_kinematics)."""
+    length = np.linalg.norm(eccentricity, axis=1, keepdims=True)
+    normal = np.where(length > 1e-300, eccentricity / np.maximum(length, 1e-300), [1.0, 0.0])
+    return normal, np.stack([-normal[:, 1], normal[:, 0]], axis=1)
+
+
 def joint_force_component(spec: SensorSpec, joint_outputs: dict) -> np.ndarray:
-    """A joint's force component; an ideal joint's 'normal' force is its reaction magnitude, its friction 0."""
+    """A joint's force component; an ideal joint's 'normal' force is its reaction magnitude, its friction 0; a
+    lubricated joint's x, y and magnitude include its oil film's force, its normal and friction are the dry contact's."""
     prefix = f"joints/{spec.joint}/"
     if spec.component in ("normal", "friction") and prefix + "normal_force" in joint_outputs:
         return joint_outputs[prefix + f"{spec.component}_force"][0]
@@ -265,12 +289,13 @@ def joint_force_component(spec: SensorSpec, joint_outputs: dict) -> np.ndarray:
             return np.zeros(len(force))
         if spec.component == "normal":
             return np.linalg.norm(force, axis=1)
-    else:  # clearance joint: the contact force on the journal in global components
-        ecc = joint_outputs[prefix + "eccentricity"][0]
-        normal = ecc / np.maximum(np.linalg.norm(ecc, axis=1, keepdims=True), 1e-300)
-        tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
+    else:  # clearance joint: the contact force on the journal in global components, and a lubricated joint's film
+        normal, tangent = eccentricity_frame(joint_outputs[prefix + "eccentricity"][0])
         force = (-joint_outputs[prefix + "normal_force"][0][:, None] * normal
                  + joint_outputs[prefix + "friction_force"][0][:, None] * tangent)
+        if prefix + "film_force" in joint_outputs:
+            film = joint_outputs[prefix + "film_force"][0]
+            force = force + film[:, :1] * normal + film[:, 1:] * tangent
     if spec.component == "x":
         return force[:, 0]
     if spec.component == "y":

@@ -7,24 +7,27 @@ from __future__ import annotations
 
 from numba import njit
 
-from clearsim.assembly.arrays import copy_into
+from clearsim.assembly.arrays import CL_CLEARANCE, CL_VISCOSITY, copy_into
 from clearsim.assembly.constraints import constraint_count
 from clearsim.assembly.dynamics import (
     constraint_violation, coordinate_count, element_states, stick_row_index,
 )
-from clearsim.assembly.forces import STICK, clearance_kinematics, contact_force_magnitudes, potential_energy
+from clearsim.assembly.forces import (
+    FREE, STICK, clearance_kinematics, contact_force_magnitudes, film_forces, potential_energy,
+)
 
-# columns of the per-joint contact output
+# columns of the per-joint contact output; the film's (a lubricated joint's oil film, zero while the dry laws act)
 C_ECC_X, C_ECC_Y, C_PENETRATION, C_RATE, C_NORMAL, C_FRICTION, C_SLIDING = range(7)
-CONTACT_FIELDS = 7
+C_FILM_RADIAL, C_FILM_TANGENTIAL, C_FILM_THICKNESS, C_FILM_ACTIVE = range(7, 11)
+CONTACT_FIELDS = 11
 E_KINETIC, E_POTENTIAL, E_VIOLATION = range(3)  # columns of the per-sample energies
 ENERGY_FIELDS = 3
 
 
 @njit(cache=True)
 def derive_sample(system, dynamics, t, state, modes, speeds, qdd, lam, contact, energies):
-    """One sample's q̈ and λ into qdd and lam, its contact fields (nc, 7) into contact, and (kinetic, potential,
-    violation) into energies."""
+    """One sample's q̈ and λ into qdd and lam, its contact fields (nc, CONTACT_FIELDS) into contact, and (kinetic,
+    potential, violation) into energies."""
     n = coordinate_count(system)
     m = constraint_count(system)
     q = state[:n].copy()
@@ -40,6 +43,12 @@ def derive_sample(system, dynamics, t, state, modes, speeds, qdd, lam, contact, 
         fields = contact[k]
         fields[C_ECC_X], fields[C_ECC_Y], fields[C_PENETRATION], fields[C_RATE] = ex, ey, penetration, rate
         fields[C_NORMAL], fields[C_FRICTION], fields[C_SLIDING] = fn, ft, sliding
+        film_active = modes[k] == FREE and system.clearance_params[k, CL_VISCOSITY] > 0.0
+        fields[C_FILM_RADIAL], fields[C_FILM_TANGENTIAL] = 0.0, 0.0
+        if film_active:
+            fields[C_FILM_RADIAL], fields[C_FILM_TANGENTIAL] = film_forces(system, k, q, qd)[:2]
+        fields[C_FILM_THICKNESS] = system.clearance_params[k, CL_CLEARANCE] - (ex * ex + ey * ey) ** 0.5
+        fields[C_FILM_ACTIVE] = 1.0 if film_active else 0.0
     kinetic = 0.0
     for b in range(system.mass.shape[0]):
         kinetic += 0.5 * (system.mass[b] * (qd[3 * b] ** 2 + qd[3 * b + 1] ** 2)

@@ -199,3 +199,68 @@ def test_a_film_model_outside_its_length_to_diameter_ratio_warns_in_the_run_summ
         result = CliRunner().invoke(app, ["run", str(path), "-o", str(tmp_path / f"{model}.h5")])
         assert result.exit_code == 0, result.output
         assert ("long_bearing film assumes L/D >= 2" in " ".join(result.output.split())) == warned, result.output
+
+
+def film_force_global(result, joint="O"):
+    """The recorded film force on the journal in global components, from its (n, t) components (a centred journal
+    takes n = x, as the solver does)."""
+    e = result[f"joints/{joint}/eccentricity"]
+    length = np.hypot(e[:, 0], e[:, 1])
+    n = np.where(length[:, None] > 1e-300, e / np.maximum(length, 1e-300)[:, None], [1.0, 0.0])
+    t = np.stack([-n[:, 1], n[:, 0]], axis=1)
+    force = result[f"joints/{joint}/film_force"]
+    return force[:, :1] * n + force[:, 1:] * t
+
+
+def test_the_recorded_film_force_carries_the_load_at_equilibrium(simulate):
+    """The spinning journal of the Ocvirk test: once settled, the film force written to the result file balances
+    the load; at every sample it is what accelerates the journal with the load (m q̈ = F_film + W)."""
+    spin, load, mass = 2000.0, 966.0, 1.0
+    result = simulate(journal(load, 30.0, spin=spin))
+    force = film_force_global(result)
+    assert np.all(result["joints/O/film_active"] == 1)  # the film carries it throughout
+    np.testing.assert_allclose(force[-1], [0.0, load], rtol=0, atol=1e-6 * load)
+    np.testing.assert_allclose(mass * result["bodies/journal/qdd"][:, :2], force + [0.0, -load], rtol=0,
+                               atol=1e-6 * load)  # q̈ is stored in float32
+    eccentricity = np.hypot(*result["joints/O/eccentricity"].T)
+    np.testing.assert_allclose(result["joints/O/film_thickness"], CLEARANCE - eccentricity, rtol=1e-6)
+
+
+def test_the_recorded_regime_switches_at_the_contact_events(simulate):
+    """The journal thrown at the wall: the film acts (and is recorded) exactly at the samples outside the dry
+    contact episodes [onset, loss), with zero film force inside them and zero dry force outside."""
+    result = simulate(journal(50.0, 20.0, spin=300.0, speed=2.0, viscosity=5e-4, rate=200))
+    time = result["time"]
+    onset, loss = result["joints/O/episodes/onset"], result["joints/O/episodes/loss"]
+    loss = np.where(np.isfinite(loss), loss, np.inf)  # an episode still open at the end
+    dry = np.any((time[:, None] >= onset[None, :]) & (time[:, None] < loss[None, :]), axis=1)
+    active = result["joints/O/film_active"]
+    assert np.any(dry) and np.any(~dry)  # precondition: both regimes sampled
+    assert np.array_equal(active == 1, ~dry)
+    assert np.all(result["joints/O/film_force"][dry] == 0.0) and np.all(result["joints/O/normal_force"][~dry] == 0.0)
+    assert np.all(np.hypot(*result["joints/O/film_force"][~dry & (time > 0)].T) > 0.0)
+    film = result["joints/O/film_thickness"]
+    assert np.min(film[~dry]) >= DRY_BELOW - 1e-11 and np.max(film[dry]) <= DRY_BELOW + 1e-11
+
+
+def test_a_dry_joint_writes_no_film_datasets(simulate):
+    result = simulate(journal(10.0, 1.0).replace(", lubrication: {viscosity: 0.05 Pa*s, length: 10 mm}", ""))
+    assert "joints/O/normal_force" in result and not any("/film_" in name for name in result)
+
+
+PIN_SENSORS = """sensors:
+  - {name: pin_load, type: joint_force, joint: O}
+  - {name: pin_x, type: joint_force, joint: O, component: x}
+  - {name: pin_y, type: joint_force, joint: O, component: y}
+"""
+
+
+def test_a_joint_force_sensor_on_a_lubricated_joint_measures_the_film_force_too(simulate):
+    """The force in a lubricated joint is the film's while it carries the journal: the settled Ocvirk journal's pin
+    force sensor reads its 966 N load, and its x, y components are the recorded film force's."""
+    load = 966.0
+    result = simulate(journal(load, 30.0, spin=2000.0) + PIN_SENSORS)
+    assert result["sensors/pin_load"][-1] == pytest.approx(load, rel=1e-6)
+    force = film_force_global(result)
+    np.testing.assert_allclose(np.stack([result["sensors/pin_x"], result["sensors/pin_y"]], axis=1), force,
+                               rtol=0, atol=1e-9 * load)

@@ -25,7 +25,8 @@ SLOW_TURN = 3.0  # a turn that takes longer than 3× the median turn of its run 
 AT_WALL = 0.5  # median |e|/c over the window at least: the journal runs along the wall (the UHV's J: 0.9–1.5), not
 # round the bearing's centre, where the angle of a small e wanders at random
 RATE_WINDOW = 1e-3  # s: the running mean of the orbit rate (orbit_rate), ≈ 2 orbits of the UHV's whirl of J
-HINT = "model the links' compliance; docs/model.md §5, \"Whirl\""
+HINT = ("model the links' compliance, the loads that keep the journal on its wall (e.g. a gas load) or a force drive; "
+        "docs/model.md §5, \"Whirl\"")
 
 
 @dataclass(frozen=True)

@@ -122,7 +122,9 @@ def stick_row(system, k, q, qd):
     """Stick constraint v_t = G q̇ = 0 of joint k: (G's bearing block, G's journal block, Ġ q̇).
 
     G q̇ = t·(ṙ_J − ṙ_B) + (n·a_J + R_J) ω_J − (n·a_B + R_B) ω_B with a = A s the arms of the joint
-    centres, and Ġ q̇ = −φ̇ (n·ė) − ω_J² (t·a_J) + ω_B² (t·a_B), φ̇ = t·ė/|e| (docs/model.md §4).
+    centres, and Ġ q̇ = −φ̇ (n·ė) − ω_J² (t·a_J) + ω_B² (t·a_B), φ̇ = t·ė/|e| (docs/model.md §4). On a worn bore
+    R_B becomes n·r (r the bore's contact point from P_B), φ̇ the rate ψ̇ at which n turns, and Ġ q̇ gains
+    −ω_B (ψ̇ − ω_B)(t·r) (docs/model-contact.md, "Worn bores and Archard wear").
     """
     p = system.clearance_params[k]
     bearing = system.clearance_bodies[k, 0]
@@ -137,7 +139,7 @@ def stick_row(system, k, q, qd):
         _, _, _, _, _, arm_x, arm_y, normal_turn = worn_contact(system, k, q, qd, ex, ey, dex, dey)
         bearing_block = (-tx, -ty, -(nx * abx + ny * aby) - (nx * arm_x + ny * arm_y))
         journal_block = (tx, ty, nx * ajx + ny * ajy + p[CL_JOURNAL_RADIUS])
-        curvature = (-normal_turn * rate - wj * wj * (tx * ajx + ty * ajy) + wb * wb * (tx * abx + ty * aby)
+        curvature = (-normal_turn * (nx * dex + ny * dey) - wj * wj * (tx * ajx + ty * ajy) + wb * wb * (tx * abx + ty * aby)
                      - wb * (normal_turn - wb) * (tx * arm_x + ty * arm_y))
         return bearing_block, journal_block, curvature
     eccentricity = np.sqrt(ex * ex + ey * ey)

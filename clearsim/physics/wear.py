@@ -131,4 +131,4 @@ def kernel_sigma(width: float, harmonics: int, radius: float) -> float:
     high = low
     while kernel_width(high, harmonics, radius) < width and high < 1e3:  # w → 2πR as σ → ∞
         high *= 2.0
-    return brentq(lambda s: kernel_width(s, harmonics, radius) - width, low, high, xtol=1e-300, rtol=4e-16)
+    return brentq(lambda s: kernel_width(s, harmonics, radius) - width, low, high, xtol=1e-300, rtol=1e-15)

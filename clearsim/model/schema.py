@@ -208,9 +208,10 @@ class Wear(Strict):
             return self
         from clearsim.physics.wear import evaluate_profile, profile_coefficients
         angles = np.linspace(0.0, 2.0 * math.pi, PROFILE_CHECK_POINTS, endpoint=False)
-        depth = evaluate_profile(profile_coefficients(self.profile.cos, self.profile.sin), angles)
+        coefficients = profile_coefficients(self.profile.cos, self.profile.sin)
+        depth = evaluate_profile(coefficients, angles)
         shallowest, deepest = int(np.argmin(depth)), int(np.argmax(depth))
-        if depth[shallowest] < 0.0:
+        if depth[shallowest] < -1e-12 * np.abs(coefficients).sum():  # a profile touching 0 may round below it
             raise ValueError(f"the wear profile's depth is negative ({depth[shallowest] * 1e3:.4g} mm at "
                              f"{math.degrees(angles[shallowest]):.1f}°): wear only removes material; raise `cos[0]`, "
                              "the mean depth, to at least the largest dip")

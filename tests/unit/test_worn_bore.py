@@ -1,6 +1,5 @@
-"""A worn bore's contact kinematics (clearsim/physics/wear.py, assembly/forces.py) against geometry computed here
-independently: the closest point of the bore curve to the journal centre, by a dense polygon and Newton's method
-on the explicitly differentiated profile."""
+"""A worn bore's contact kinematics (clearsim/physics/wear.py, assembly/forces.py) against geometry computed
+independently (tests/support/worn_bore.py): the closest point of the bore curve to the journal centre."""
 
 import numpy as np
 import pytest
@@ -10,6 +9,7 @@ from clearsim.assembly.forces import clearance_kinematics, stick_row
 from clearsim.assembly.system import assemble
 from clearsim.model.loader import load_mechanism_text
 from clearsim.physics import wear
+from tests.support.worn_bore import nearest_bore_contact
 
 BEARING_RADIUS = 0.02
 CLEARANCE = 1e-4
@@ -49,22 +49,12 @@ def system():
     return for_kernels(assemble(load_mechanism_text(MODEL).mechanism).arrays)
 
 
-def reference_contact(local_e):
-    """(δ, n) in the bearing frame: the bore point nearest to e from 20 000 polygon vertices, refined by Newton's
-    method on (r − e)·r' = 0."""
-    def curve(theta):
-        rho, slope, curvature = BEARING_RADIUS + depth(theta), depth_slope(theta), depth_curvature(theta)
-        u, v = np.array([np.cos(theta), np.sin(theta)]), np.array([-np.sin(theta), np.cos(theta)])
-        return rho * u, slope * u + rho * v, (curvature - rho) * u + 2 * slope * v
+def profile(theta):
+    return depth(theta), depth_slope(theta), depth_curvature(theta)
 
-    grid = np.linspace(0, 2 * np.pi, 20000, endpoint=False)
-    polygon = (BEARING_RADIUS + depth(grid)) * np.array([np.cos(grid), np.sin(grid)])
-    theta = grid[np.argmin(np.hypot(*(polygon - local_e[:, None])))]
-    for _ in range(30):
-        r, tangent, second = curve(theta)
-        theta -= (r - local_e) @ tangent / (tangent @ tangent + (r - local_e) @ second)
-    gap = curve(theta)[0] - local_e
-    return JOURNAL_RADIUS - np.hypot(*gap), gap / np.hypot(*gap)
+
+def reference_contact(local_e):
+    return nearest_bore_contact(profile, BEARING_RADIUS, JOURNAL_RADIUS, local_e)
 
 
 def journal_states(count=60, seed=3):

@@ -6,8 +6,12 @@ import math
 import numpy as np
 import pytest
 from scipy.optimize import brentq
+from typer.testing import CliRunner
+
+from clearsim.cli import app
 
 from tests.support.worn_bore import nearest_bore_contact, rotate
+from tests.validation.conftest import CONFIGS
 from tests.validation.test_energy import CLEARANCE_PENDULUM, total_energy
 
 FORCE, STIFFNESS = 1000.0, 1e12  # N, N/m^1.5: a static penetration (F/K)^(2/3) = 1 µm
@@ -151,3 +155,21 @@ def test_with_wear_the_written_dissipation_closes_the_energy_balance(simulate):
     assert lost > 1e-4 * np.max(result["energy/kinetic"])
     assert np.max(np.abs(result["energy/balance_error"])) <= 1e-3 * lost
     assert result["joints/O/wear/volume"][-1] > 0.0
+
+
+@pytest.mark.parametrize("wear, place, message", [
+    ("{profile: {cos: [0.01 mm, 0.02 mm]}}", "joints[9] 'J' → wear", "depth is negative (-0.01 mm at 180.0°)"),
+    ("{profile: {cos: [1 mm, 0.5 mm]}, wall: 1 mm}", "joints[9] 'J' → wear", "1.5 mm deep at 0.0°, deeper than the wall"),
+    ("{archard: {coefficient: -1e-4, hardness: 2 GPa, length: 40 mm}}", "joints[9] 'J' → wear → archard → coefficient",
+     "must be at least 0"),
+    ("{archard: {coefficient: 1e-4, hardness: 2 GPa}}", "joints[9] 'J' → wear → archard → length",
+     "needs the length L of the worn band"),
+    ("{archard: {coefficient: 1e-4, hardness: 2 GPa, length: 40 mm, width: 400 mm}}",
+     "joints[9] 'J' → wear → archard → width", "not shorter than the bore's circumference 314.159 mm"),
+], ids=["negative_depth", "deeper_than_wall", "negative_coefficient", "no_length", "too_wide"])
+def test_bad_wear_input_exits_2_with_a_located_message(wear, place, message):
+    override = f"joints.J.wear={wear}"
+    result = CliRunner().invoke(app, ["validate", str(CONFIGS / "uhv_breaker.yaml"), "--set", override])
+    assert result.exit_code == 2, result.output
+    assert f"in --set {override}  {place}\n" in result.output and message in result.output
+    assert "Traceback" not in result.output

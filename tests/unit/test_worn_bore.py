@@ -141,4 +141,17 @@ def test_the_wear_kernel_has_the_stated_width_and_unit_volume(width):
     assert rates[0] == pytest.approx(1 / (2 * np.pi), rel=1e-15)
     assert wear.evaluate_profile(rates, [0.7])[0] == pytest.approx(BEARING_RADIUS / width, rel=1e-12)
     assert angles[np.argmax(kernel)] == pytest.approx(0.7, abs=2 * np.pi / 4000)
-    assert kernel.min() > -1e-3 * kernel.max()
+    assert kernel.min() > -1e-4 * kernel.max()
+
+
+@pytest.mark.parametrize("harmonics", [8, 64, 512])
+def test_the_narrowest_kernel_hardly_rings(harmonics):
+    """σ = 4/M: the truncated series' negative lobes stay below 1e-4 of its peak; a narrower width is raised to it."""
+    narrowest = wear.narrowest_width(harmonics, BEARING_RADIUS)
+    assert wear.kernel_sigma(0.1 * narrowest, harmonics, BEARING_RADIUS) == wear.SMALLEST_SIGMA / harmonics
+    rates = np.zeros(2 * harmonics + 1)
+    weights = wear.kernel_weights(wear.SMALLEST_SIGMA / harmonics, harmonics)
+    wear.add_kernel_rates(rates, weights, harmonics, 1.0, 0.3)
+    kernel = wear.evaluate_profile(rates, np.linspace(0, 2 * np.pi, 20000, endpoint=False))
+    assert kernel.min() > -1e-4 * kernel.max()
+    assert narrowest == pytest.approx(np.sqrt(2 * np.pi) * BEARING_RADIUS * 4 / harmonics, rel=1e-3)

@@ -115,7 +115,7 @@ def _wear_numbers(spec, bearing_radius: float, pin_length: float | None, lubrica
         return {}
     numbers = {}
     if spec.profile is not None:
-        coefficients = wear.profile_coefficients(spec.profile.cos, spec.profile.sin)
+        coefficients = spec.profile.coefficients()
         if lubricated and coefficients.any():
             raise ResolveError(("wear", "profile"), "a worn profile is not modelled under an oil film (the film "
                                "laws assume a circular bore)", "remove the joint's lubrication or its wear profile")

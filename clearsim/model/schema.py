@@ -172,11 +172,42 @@ class LubricationSpec(Strict):
 DEFAULT_LUBRICATION = LubricationSpec(model="short_bearing", cavitation="half_sommerfeld", dry_below=1.5e-6)
 
 
+MEASURED_PROFILE_HARMONICS = 32  # default harmonics of a fitted measured profile (fewer when the points allow fewer)
+
+
 class WearProfile(Strict):
-    """Wear depth h(θ) = a_0 + Σ a_m cos mθ + b_m sin mθ of a bore, θ in the bearing body's frame from its x axis."""
+    """Wear depth h(θ) = a_0 + Σ a_m cos mθ + b_m sin mθ of a bore, θ in the bearing body's frame from its x axis:
+    its coefficients (`cos`, `sin`), or measured depths (`angles`, `depth`) fitted by least squares."""
 
     cos: list[Length] = Field([], description="[a_0, a_1, a_2, ...]: the mean depth and the cosine terms")
     sin: list[Length] = Field([], description="[b_1, b_2, ...]: the sine terms")
+    angles: list[Angle] = Field([], description="angles θ of measured `depth` values (instead of `cos`, `sin`)")
+    depth: list[Length] = Field([], description="measured wear depths at `angles`, fitted by least squares")
+    harmonics: int | None = Field(None, ge=0, description="harmonics M of the fit to measured depths; default: "
+                                  "as many as the points allow, (N − 1)/2, at most 32")
+
+    @model_validator(mode="after")
+    def _one_form(self) -> "WearProfile":
+        if (self.cos or self.sin) and (self.angles or self.depth):
+            raise ValueError("give the profile as `cos`/`sin` coefficients or as measured `angles`/`depth`, not both")
+        if len(self.angles) != len(self.depth):
+            raise ValueError(f"{len(self.angles)} angles but {len(self.depth)} depths: give one depth per angle")
+        points = len({round(math.remainder(a, 2.0 * math.pi), 12) for a in self.angles})
+        if self.angles and 2 * self.fit_harmonics() + 1 > points:
+            raise ValueError(f"{points} distinct angles fit at most {(points - 1) // 2} harmonics, not "
+                             f"{self.fit_harmonics()}: measure more angles or lower `harmonics`")
+        return self
+
+    def fit_harmonics(self) -> int:
+        points = len(self.angles)
+        return self.harmonics if self.harmonics is not None else min((points - 1) // 2, MEASURED_PROFILE_HARMONICS)
+
+    def coefficients(self) -> np.ndarray:
+        """[a_0, a_1, b_1, ...] (m)."""
+        from clearsim.physics.wear import fitted_coefficients, profile_coefficients
+        if self.angles:
+            return fitted_coefficients(self.angles, self.depth, self.fit_harmonics())
+        return profile_coefficients(self.cos, self.sin)
 
 
 PROFILE_CHECK_POINTS = 4096  # the profile's depth is checked on this many angles (≥ 8 per period of harmonic 512)
@@ -206,9 +237,9 @@ class Wear(Strict):
     def _profile_within_wall(self) -> "Wear":
         if self.profile is None:
             return self
-        from clearsim.physics.wear import evaluate_profile, profile_coefficients
+        from clearsim.physics.wear import evaluate_profile
         angles = np.linspace(0.0, 2.0 * math.pi, PROFILE_CHECK_POINTS, endpoint=False)
-        coefficients = profile_coefficients(self.profile.cos, self.profile.sin)
+        coefficients = self.profile.coefficients()
         depth = evaluate_profile(coefficients, angles)
         shallowest, deepest = int(np.argmin(depth)), int(np.argmax(depth))
         if depth[shallowest] < -1e-12 * np.abs(coefficients).sum():  # a profile touching 0 may round below it

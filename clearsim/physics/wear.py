@@ -106,6 +106,16 @@ def profile_coefficients(cos: list[float], sin: list[float]) -> np.ndarray:
     return coefficients
 
 
+def fitted_coefficients(angles, depths, harmonics: int) -> np.ndarray:
+    """[a_0, a_1, b_1, ...] of the M-harmonic series nearest to measured depths (least squares; interpolation when
+    2M + 1 equals the number of distinct angles)."""
+    angles = np.asarray(angles, float)
+    columns = [np.ones_like(angles)]
+    for m in range(1, harmonics + 1):
+        columns += [np.cos(m * angles), np.sin(m * angles)]
+    return np.linalg.lstsq(np.column_stack(columns), np.asarray(depths, float), rcond=None)[0]
+
+
 def kernel_weights(sigma: float, harmonics: int) -> np.ndarray:
     """g_m = exp(−m²σ²/2), m = 0..M."""
     m = np.arange(harmonics + 1, dtype=float)

@@ -155,3 +155,13 @@ def test_the_narrowest_kernel_hardly_rings(harmonics):
     kernel = wear.evaluate_profile(rates, np.linspace(0, 2 * np.pi, 20000, endpoint=False))
     assert kernel.min() > -1e-4 * kernel.max()
     assert narrowest == pytest.approx(np.sqrt(2 * np.pi) * BEARING_RADIUS * 4 / harmonics, rel=1e-3)
+
+
+def test_a_measured_profile_is_fitted_to_its_series():
+    """Depths measured at 12 angles of a profile with 2 harmonics give back its coefficients (least squares)."""
+    angles = np.radians(np.arange(0, 360, 30))
+    text = MODEL.replace(f"profile: {{cos: [{MEAN} m, 0, {OVAL} m], sin: [{TILT} m]}}",
+                         f"profile: {{angles: [{', '.join(f'{a} rad' for a in angles)}], "
+                         f"depth: [{', '.join(f'{d} m' for d in depth(angles))}], harmonics: 2}}")
+    fitted = assemble(load_mechanism_text(text).mechanism).arrays.wear_profile[0]
+    assert fitted == pytest.approx([MEAN, 0.0, TILT, OVAL, 0.0], abs=1e-18)

@@ -166,7 +166,12 @@ def test_with_wear_the_written_dissipation_closes_the_energy_balance(simulate):
      "needs the length L of the worn band"),
     ("{archard: {coefficient: 1e-4, hardness: 2 GPa, length: 40 mm, width: 400 mm}}",
      "joints[9] 'J' → wear → archard → width", "not shorter than the bore's circumference 314.159 mm"),
-], ids=["negative_depth", "deeper_than_wall", "negative_coefficient", "no_length", "too_wide"])
+    ("{profile: {angles: [0 deg, 120 deg, 240 deg], depth: [0.01 mm, 0.02 mm, 0.01 mm], harmonics: 2}}",
+     "joints[9] 'J' → wear → profile", "3 distinct angles fit at most 1 harmonics, not 2"),
+    ("{profile: {angles: [0 deg, 120 deg], depth: [0.01 mm]}}", "joints[9] 'J' → wear → profile",
+     "2 angles but 1 depths"),
+], ids=["negative_depth", "deeper_than_wall", "negative_coefficient", "no_length", "too_wide", "too_few_angles",
+        "one_depth_per_angle"])
 def test_bad_wear_input_exits_2_with_a_located_message(wear, place, message):
     override = f"joints.J.wear={wear}"
     result = CliRunner().invoke(app, ["validate", str(CONFIGS / "uhv_breaker.yaml"), "--set", override])

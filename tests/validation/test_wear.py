@@ -143,11 +143,17 @@ def test_elastic_impacts_on_a_worn_bore_conserve_energy(simulate, bodies):
     assert np.max(np.abs(result["energy/contact_dissipated"])) <= 1e-9 * scale
 
 
-def test_with_wear_the_written_dissipation_closes_the_energy_balance(simulate):
-    """A damped, frictional worn bore accumulating wear: wear takes no energy of its own (the friction work it
-    comes from is booked once), and the balance closes as on a circular bore."""
+@pytest.mark.parametrize("bodies, friction", [
+    ("[ground, link]", "{law: coulomb, mu_d: 0.15, stick: smooth}"),
+    ("[link, ground]", "{law: stiction_step, mu_s: 0.2, mu_d: 0.15, v_s: 1e-4 m/s, v_d: 1e-2 m/s}"),
+], ids=["fixed_bore_smooth", "swinging_bore_exact_stick"])
+def test_with_wear_the_written_dissipation_closes_the_energy_balance(simulate, bodies, friction):
+    """A damped, frictional worn bore accumulating wear, fixed or swinging with the link and then held by the exact
+    stick constraint while it sticks: wear takes no energy of its own (the friction work it comes from is booked
+    once), and the balance closes as on a circular bore."""
     text = CLEARANCE_PENDULUM.replace("law: hertz, restitution: 1.0", "law: lankarani_nikravesh, restitution: 0.7")
-    text = text.replace("  contact:", "  friction: {law: coulomb, mu_d: 0.15, stick: smooth}\n  contact:")
+    text = text.replace("bodies: [ground, link]", f"bodies: {bodies}")
+    text = text.replace("  contact:", f"  friction: {friction}\n  contact:")
     text = text.replace("clearance: 0.1 mm}", "clearance: 0.1 mm, wear: {profile: {cos: [0.03 mm, 0, 0.02 mm]}, "
                         "archard: {coefficient: 1e-4, hardness: 2 GPa, length: 10 mm}}}")
     result = simulate(text)
@@ -155,6 +161,8 @@ def test_with_wear_the_written_dissipation_closes_the_energy_balance(simulate):
     assert lost > 1e-4 * np.max(result["energy/kinetic"])
     assert np.max(np.abs(result["energy/balance_error"])) <= 1e-3 * lost
     assert result["joints/O/wear/volume"][-1] > 0.0
+    if "stiction" in friction:
+        assert np.any(result["joints/O/stick"] == 1)  # the exact stick row of the worn bore was used
 
 
 @pytest.mark.parametrize("wear, place, message", [

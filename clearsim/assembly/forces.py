@@ -102,10 +102,11 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
 
 
 @njit(cache=True)
-def bearing_contact_arm(system, k, q, qd, nx, ny):
-    """The bearing's contact point relative to its centre P_B (global): R_B n on a circular bore."""
+def bearing_contact_arm(system, k, q, qd, kinematics):
+    """The bearing's contact point relative to its centre P_B (global), from the joint's clearance_kinematics: R_B n
+    on a circular bore."""
+    ex, ey, dex, dey, _, _, nx, ny, _ = kinematics
     if system.wear_harmonics[k] > 0:
-        ex, ey, dex, dey = clearance_kinematics(system, k, q, qd)[:4]
         return worn_contact(system, k, q, qd, ex, ey, dex, dey)[5:7]
     radius = system.clearance_params[k, CL_BEARING_RADIUS]
     return radius * nx, radius * ny
@@ -177,7 +178,8 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized):
     contact_loss = 0.0
     friction_loss = 0.0
     for k in range(system.clearance_bodies.shape[0]):
-        ex, ey, dex, dey, penetration, rate, nx, ny, sliding = clearance_kinematics(system, k, q, qd)
+        kinematics = clearance_kinematics(system, k, q, qd)
+        ex, ey, dex, dey, penetration, rate, nx, ny, sliding = kinematics
         if modes[k] == FREE and system.clearance_params[k, CL_VISCOSITY] > 0.0:
             contact_loss += add_film_forces(system, k, q, qd, generalized)
             continue
@@ -193,7 +195,7 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized):
         bx, by = point_position(q, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
         add_global_force(generalized, q, journal, bx + ex + p[CL_JOURNAL_RADIUS] * nx,
                          by + ey + p[CL_JOURNAL_RADIUS] * ny, fx, fy)
-        arm_x, arm_y = bearing_contact_arm(system, k, q, qd, nx, ny)
+        arm_x, arm_y = bearing_contact_arm(system, k, q, qd, kinematics)
         add_global_force(generalized, q, bearing, bx + arm_x, by + arm_y, -fx, -fy)
         friction_loss -= ft * sliding
     return contact_loss, friction_loss
@@ -213,11 +215,12 @@ def add_wear_rates(system, q, qd, modes, impact_speeds, zdot):
             rates[i] = 0.0
         if modes[k] == STICK or modes[k] == FREE:
             continue
-        _, _, _, _, penetration, rate, nx, ny, sliding = clearance_kinematics(system, k, q, qd)
+        kinematics = clearance_kinematics(system, k, q, qd)
+        _, _, _, _, penetration, rate, _, _, sliding = kinematics
         fn = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], impact_speeds[k])[0]
         if fn == 0.0:
             continue
-        arm_x, arm_y = bearing_contact_arm(system, k, q, qd, nx, ny)
+        arm_x, arm_y = bearing_contact_arm(system, k, q, qd, kinematics)
         contact_angle = np.arctan2(arm_y, arm_x) - body_pose(q, system.clearance_bodies[k, 0])[2]
         add_kernel_rates(rates, system.wear_rates[k, 1:], harmonics,
                          system.wear_rates[k, WEAR_SCALE] * fn * abs(sliding), contact_angle)

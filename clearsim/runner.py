@@ -216,8 +216,8 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                         if episodes:
                             _write_episodes(writer, system, run, np.concatenate(episodes))
                         if run is not None:
-                            for group, (columns, table_attributes) in wear_profile_tables(system, run.y, run.time).items():
-                                writer.write_table(group, columns, table_attributes)
+                            for group, table in wear_profile_tables(system, run.y, run.time).items():
+                                writer.write_table(group, *table)  # the accumulated wear profiles, at the end
                 except OSError as exc:
                     if not isinstance(error, ResultWriteError):  # the first write failure is the one to report
                         error = write_failure(output, exc, needed)

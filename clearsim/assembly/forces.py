@@ -92,7 +92,8 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
     arm_x, arm_y = c * rx - s * ry, s * rx + c * ry
     relative_x, relative_y = dex + wb * arm_y, dey - wb * arm_x  # ė − ω_B k×r
     rate = nx * relative_x + ny * relative_y
-    sliding = -ny * relative_x + nx * relative_y + body_rates(qd, system.clearance_bodies[k, 1])[2] * p[CL_JOURNAL_RADIUS]
+    wj = body_rates(qd, system.clearance_bodies[k, 1])[2]
+    sliding = -ny * relative_x + nx * relative_y + wj * p[CL_JOURNAL_RADIUS]
     frame_x, frame_y = dex + wb * ey, dey - wb * ex  # ė − ω_B k×e, turned into the bearing frame below
     local_rate_x, local_rate_y = c * frame_x + s * frame_y, -s * frame_x + c * frame_y
     foot_rate = (tangent_x * local_rate_x + tangent_y * local_rate_y) / curvature  # θ̇* of the closest point
@@ -140,8 +141,8 @@ def stick_row(system, k, q, qd):
         _, _, _, _, _, arm_x, arm_y, normal_turn = worn_contact(system, k, q, qd, ex, ey, dex, dey)
         bearing_block = (-tx, -ty, -(nx * abx + ny * aby) - (nx * arm_x + ny * arm_y))
         journal_block = (tx, ty, nx * ajx + ny * ajy + p[CL_JOURNAL_RADIUS])
-        curvature = (-normal_turn * (nx * dex + ny * dey) - wj * wj * (tx * ajx + ty * ajy) + wb * wb * (tx * abx + ty * aby)
-                     - wb * (normal_turn - wb) * (tx * arm_x + ty * arm_y))
+        curvature = (-normal_turn * (nx * dex + ny * dey) - wj * wj * (tx * ajx + ty * ajy)
+                     + wb * wb * (tx * abx + ty * aby) - wb * (normal_turn - wb) * (tx * arm_x + ty * arm_y))
         return bearing_block, journal_block, curvature
     eccentricity = np.sqrt(ex * ex + ey * ey)
     orbit_rate = (tx * dex + ty * dey) / eccentricity if eccentricity > 1e-300 else 0.0

@@ -78,6 +78,19 @@ def test_archard_depth_under_a_steady_load_grows_as_the_closed_form(simulate):
     assert depth[np.argmin(np.abs(angles - 0.5 * math.pi))] < 1e-3 * depth[loaded]  # nothing worn opposite
 
 
+def test_a_bearing_turning_under_a_steady_load_wears_evenly_in_its_own_frame(simulate):
+    """The bearing turns once at ω under the pin (pressed down by F, not turning): the contact sweeps the whole bore
+    in the bearing's frame, so after the turn the profile is even, k_w F ω R_B t/(2π R_B L H) deep (1e-6)."""
+    k_w, hardness, length, omega = 1e-4, 2e9, 0.02, 100.0
+    turn_time = 2 * math.pi / omega
+    result = simulate(loaded_pin(f"{{archard: {{coefficient: {k_w}, hardness: {hardness} Pa, length: {length} m}}}}",
+                                 spin="0 rad/s", turn=f"{omega} rad/s", t_end=f"{turn_time} s"))
+    volume = k_w * FORCE * omega * BEARING_RADIUS * turn_time / hardness
+    assert result["joints/J/wear/volume"][-1] == pytest.approx(volume, rel=1e-6)
+    depth = result["joints/J/wear/depth"]
+    assert depth == pytest.approx(volume / (2 * math.pi * BEARING_RADIUS * length), rel=1e-6)
+
+
 def test_no_sliding_no_wear(simulate):
     result = simulate(loaded_pin("{archard: {coefficient: 1e-4, hardness: 2 GPa, length: 20 mm}}", spin="0 rad/s",
                                  t_end="2 ms"))

@@ -96,7 +96,9 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
     sliding = -ny * relative_x + nx * relative_y + wj * p[CL_JOURNAL_RADIUS]
     frame_x, frame_y = dex + wb * ey, dey - wb * ex  # ė − ω_B k×e, turned into the bearing frame below
     local_rate_x, local_rate_y = c * frame_x + s * frame_y, -s * frame_x + c * frame_y
-    foot_rate = (tangent_x * local_rate_x + tangent_y * local_rate_y) / curvature  # θ̇* of the closest point
+    foot_rate = 0.0  # θ̇* of the closest point (none where it is not a minimum: free flight near the centre)
+    if curvature > 0.0:
+        foot_rate = (tangent_x * local_rate_x + tangent_y * local_rate_y) / curvature
     normal_turn = wb + ((-local_ny * tangent_x + local_nx * tangent_y) * foot_rate
                         - (-local_ny * local_rate_x + local_nx * local_rate_y)) / distance
     return p[CL_JOURNAL_RADIUS] - distance, rate, nx, ny, sliding, arm_x, arm_y, normal_turn

@@ -49,6 +49,8 @@ def closest_bore_point(coefficients, harmonics, bearing_radius, ex, ey):
     theta = np.arctan2(ey, ex) if ex * ex + ey * ey > 0.0 else 0.0
     for _ in range(NEWTON_ITERATIONS):
         rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
+        if second <= 0.0:  # e far from the wall, near a centre of curvature (in free flight): keep θ
+            break
         step = gradient / second
         theta -= step
         if abs(step) < 1e-15:

@@ -165,3 +165,11 @@ def test_a_measured_profile_is_fitted_to_its_series():
                          f"depth: [{', '.join(f'{d} m' for d in depth(angles))}], harmonics: 2}}")
     fitted = assemble(load_mechanism_text(text).mechanism).arrays.wear_profile[0]
     assert fitted == pytest.approx([MEAN, 0.0, TILT, OVAL, 0.0], abs=1e-18)
+
+
+def test_a_centred_journal_has_finite_kinematics(system):
+    """At the centre of an oval bore (the start of a run) the nearest-point search has no minimum to converge to; the
+    kinematics stay finite and far from contact."""
+    kinematics = clearance_kinematics(system, 0, np.zeros(6), np.array([0.0, 0.0, 1.0, 1e-3, -1e-3, 2.0]))
+    assert np.all(np.isfinite(kinematics)) and kinematics[4] < -CLEARANCE
+    assert np.all(np.isfinite(stick_row(system, 0, np.zeros(6), np.ones(6))[2]))

@@ -30,6 +30,7 @@ from clearsim.io.hdf5 import (
     CHUNK_ROWS, NotAResultFile, ResultWriteError, ResultWriter, check_free_space, group_attribute, interrupts_deferred,
     read_result, result_overview, write_failure,
 )
+from clearsim.io.wear_results import archard_joints, wear_profile_tables
 from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
 from clearsim.model.flexible import flexible_link_names
 from clearsim.model.modes import flexible_modes_attribute, mode_lines
@@ -214,6 +215,9 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                         pending.flush()
                         if episodes:
                             _write_episodes(writer, system, run, np.concatenate(episodes))
+                        if run is not None:
+                            for group, table in wear_profile_tables(system, run.y, run.time).items():
+                                writer.write_table(group, *table)  # the accumulated wear profiles, at the end
                 except OSError as exc:
                     if not isinstance(error, ResultWriteError):  # the first write failure is the one to report
                         error = write_failure(output, exc, needed)
@@ -288,6 +292,7 @@ def result_values(system: System) -> dict[str, int]:
         "energy/e": (BASE_ENERGIES + len(driveline_dissipations(system)) + len(stored)
                      + HYDRAULIC_ENERGIES * bool(system.hydraulic_cylinders)),
         "constraints/violation": 1,
+        "joints/j/wear": 2 * len(archard_joints(system)),
     }
 
 

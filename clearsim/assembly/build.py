@@ -15,12 +15,12 @@ from clearsim.assembly.arrays import (
     CLEARANCE_COLUMNS, CLEARANCE_LAW_COLUMNS, CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_DRY_GAP,
     CL_EXPONENT, CL_FILM_LENGTH, CL_JOURNAL_POINT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S,
     CL_RESTITUTION, CL_STIFFNESS, CL_V_HIGH, CL_V_LOW, CL_VISCOSITY, HYDRAULIC_COLUMNS, HYDRAULIC_LAW_COLUMNS,
-    LOAD_COLUMNS, SPRING_COLUMNS, TORSION_COLUMNS, SystemArrays,
+    LOAD_COLUMNS, SPRING_COLUMNS, TORSION_COLUMNS, WEAR_SCALE, SystemArrays,
 )
 from clearsim.errors import Problem
 from clearsim.model import schema
 from clearsim.model.resolve import ClearanceParameters, resolve_clearance
-from clearsim.physics import contact, cylindrical, friction, lubrication, motion
+from clearsim.physics import contact, cylindrical, friction, lubrication, motion, wear
 from clearsim.physics.tables import read_table_column
 from clearsim.units import UnitError, to_si
 
@@ -288,4 +288,36 @@ def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: l
         hydraulic_laws=_int_array([c[3] for c in cylinders], HYDRAULIC_LAW_COLUMNS),
         torsion_bodies=_int_array([s[0] for s in torsions], 2),
         torsion_params=_float_array([s[1] for s in torsions], TORSION_COLUMNS),
+        **wear_arrays([c[4] for c in clearances], first_slot=sum(len(c[4]) for c in cylinders)),
     )
+
+
+def wear_arrays(parameters: list[ClearanceParameters], first_slot: int) -> dict:
+    """The wear_* arrays of the clearance joints (arrays.py): their worn profiles, and the slots in z (from
+    first_slot on, after the cylinders' states) and rate factors of their Archard profiles."""
+    count = len(parameters)
+    profile_width = max([len(p.wear_profile) for p in parameters] + [1])
+    profile = np.zeros((count, profile_width))
+    rate_width = max([p.archard.harmonics + 2 for p in parameters if p.archard] + [2])
+    rates = np.zeros((count, rate_width))
+    slots = np.full((count, 2), -1, np.int64)
+    for k, p in enumerate(parameters):
+        profile[k, :len(p.wear_profile)] = p.wear_profile
+        if p.archard is not None:
+            slots[k] = first_slot, p.archard.harmonics
+            first_slot += archard_state_count(p.archard)
+            rates[k, WEAR_SCALE] = p.archard.coefficient / (p.archard.hardness * p.archard.length * p.bearing_radius
+                                                            * p.clearance)
+            rates[k, 1:p.archard.harmonics + 2] = wear.kernel_weights(p.archard.sigma, p.archard.harmonics)
+    return {"wear_harmonics": np.array([(len(p.wear_profile) - 1) // 2 for p in parameters], np.int64).reshape(count),
+            "wear_profile": profile, "wear_slots": slots, "wear_rates": rates}
+
+
+def archard_state_count(archard) -> int:
+    """States of an accumulated profile: its 2M + 1 Fourier coefficients."""
+    return 2 * archard.harmonics + 1
+
+
+def wear_state_count(arrays: SystemArrays) -> int:
+    """States of all accumulated wear profiles (at the end of z)."""
+    return int(sum(2 * harmonics + 1 for slot, harmonics in arrays.wear_slots if slot >= 0))

@@ -22,7 +22,7 @@ from clearsim.assembly.constraints import (
     jacobian_times, jacobian_transpose_times, prescribed, schur_complement,
 )
 from clearsim.assembly.forces import (
-    STICK, add_applied_forces, add_clearance_forces, add_global_force, clearance_kinematics, stick_row,
+    STICK, add_applied_forces, add_clearance_forces, add_global_force, add_wear_rates, clearance_kinematics, stick_row,
 )
 from clearsim.assembly.drivelines import add_driveline_forces, driveline_powers
 from clearsim.assembly.hydraulics import add_hydraulic_forces, hydraulic_rates
@@ -314,6 +314,7 @@ def rhs(system, dynamics, t, y, modes, impact_speeds, ydot):
     dashpot, guide_friction, latch = driveline_powers(system, t, q, qd)
     ydot[2 * n + WORK_APPLIED] = applied + latch
     supply, tank, orifice, oil = hydraulic_rates(system, t, q, qd, z, element_states(system, ydot))
+    add_wear_rates(system, q, qd, modes, impact_speeds, element_states(system, ydot))
     ydot[2 * n + WORK_SUPPLY] = supply
     ydot[2 * n + WORK_TANK] = tank
     ydot[2 * n + WORK_ORIFICE] = orifice

@@ -20,7 +20,8 @@ from numba import njit
 from clearsim.assembly.arrays import (
     CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_POINT,
     CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_RESTITUTION, CL_STIFFNESS,
-    CL_V_HIGH, CL_V_LOW, CL_DRY_GAP, CL_FILM_LENGTH, CL_VISCOSITY, LAW_FILM_MODEL,
+    CL_V_HIGH, CL_V_LOW, CL_DRY_GAP, CL_FILM_LENGTH, CL_VISCOSITY, LAW_FILM_MODEL, WEAR_SCALE, WEAR_SLOT,
+    WEAR_SLOT_HARMONICS,
 )
 from clearsim.assembly.kinematics import (
     GROUND, add_global_force, add_point_force, body_frame, body_pose, body_rates, frame_point, frame_rotate,
@@ -32,6 +33,7 @@ from clearsim.physics.contact import damped_force
 from clearsim.physics.cylindrical import law_state
 from clearsim.physics.friction import STICK_EXACT, friction_coefficient, sliding_coefficient
 from clearsim.physics.lubrication import film_force, film_torque
+from clearsim.physics.wear import add_kernel_rates, closest_bore_point
 
 # modes of a clearance joint, constant within a step. CONTACT is any contact of a smooth friction
 # law, and sliding along +t under an exact-stick law; STICK and SLIDE_BACK (sliding along −t)
@@ -56,6 +58,9 @@ def clearance_kinematics(system, k, q, qd):
     jvx, jvy = frame_velocity(journal_frame, qd, journal, p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
     ex, ey = jx - bx, jy - by
     dex, dey = jvx - bvx, jvy - bvy
+    if system.wear_harmonics[k] > 0:
+        penetration, rate, nx, ny, sliding = worn_contact(system, k, q, qd, ex, ey, dex, dey)[:5]
+        return ex, ey, dex, dey, penetration + p[CL_DRY_GAP], rate, nx, ny, sliding
     eccentricity = np.sqrt(ex * ex + ey * ey)
     nx, ny = 1.0, 0.0  # a centred journal has no contact direction; any unit vector will do
     if eccentricity > 1e-300:
@@ -64,6 +69,50 @@ def clearance_kinematics(system, k, q, qd):
                - body_rates(qd, bearing)[2] * p[CL_BEARING_RADIUS])
     penetration = eccentricity - p[CL_CLEARANCE] + p[CL_DRY_GAP]
     return ex, ey, dex, dey, penetration, nx * dex + ny * dey, nx, ny, sliding
+
+
+@njit(cache=True)
+def worn_contact(system, k, q, qd, ex, ey, dex, dey):
+    """(δ, δ̇, n_x, n_y, v_t, r_x, r_y, ψ̇) of clearance joint k with a worn bore (physics/wear.py), e = (ex, ey) and
+    its rate global: the journal touches the bore at its point r closest to P_J (r from P_B, global), with the bore's
+    normal n there; δ = R_J − |r − e|, δ̇ = n·(ė − ω_B k×r), v_t = t·(ė − ω_B k×r) + ω_J R_J, and ψ̇ the rate at
+    which n turns (docs/model-contact.md, "Worn bores and Archard wear")."""
+    p = system.clearance_params[k]
+    bearing = system.clearance_bodies[k, 0]
+    angle = body_pose(q, bearing)[2]
+    wb = body_rates(qd, bearing)[2]
+    c, s = np.cos(angle), np.sin(angle)
+    local_x, local_y = c * ex + s * ey, -s * ex + c * ey
+    _, rx, ry, tangent_x, tangent_y, curvature = closest_bore_point(
+        system.wear_profile[k], system.wear_harmonics[k], p[CL_BEARING_RADIUS], local_x, local_y)
+    gap_x, gap_y = rx - local_x, ry - local_y
+    distance = np.sqrt(gap_x * gap_x + gap_y * gap_y)
+    local_nx, local_ny = gap_x / distance, gap_y / distance
+    nx, ny = c * local_nx - s * local_ny, s * local_nx + c * local_ny
+    arm_x, arm_y = c * rx - s * ry, s * rx + c * ry
+    relative_x, relative_y = dex + wb * arm_y, dey - wb * arm_x  # ė − ω_B k×r
+    rate = nx * relative_x + ny * relative_y
+    wj = body_rates(qd, system.clearance_bodies[k, 1])[2]
+    sliding = -ny * relative_x + nx * relative_y + wj * p[CL_JOURNAL_RADIUS]
+    frame_x, frame_y = dex + wb * ey, dey - wb * ex  # ė − ω_B k×e, turned into the bearing frame below
+    local_rate_x, local_rate_y = c * frame_x + s * frame_y, -s * frame_x + c * frame_y
+    foot_rate = 0.0  # θ̇* of the closest point (none where it is not a minimum: free flight near the centre)
+    if curvature > 0.0:
+        foot_rate = (tangent_x * local_rate_x + tangent_y * local_rate_y) / curvature
+    normal_turn = wb + ((-local_ny * tangent_x + local_nx * tangent_y) * foot_rate
+                        - (-local_ny * local_rate_x + local_nx * local_rate_y)) / distance
+    return p[CL_JOURNAL_RADIUS] - distance, rate, nx, ny, sliding, arm_x, arm_y, normal_turn
+
+
+@njit(cache=True)
+def bearing_contact_arm(system, k, q, qd, kinematics):
+    """The bearing's contact point relative to its centre P_B (global), from the joint's clearance_kinematics: R_B n
+    on a circular bore."""
+    ex, ey, dex, dey, _, _, nx, ny, _ = kinematics
+    if system.wear_harmonics[k] > 0:
+        return worn_contact(system, k, q, qd, ex, ey, dex, dey)[5:7]
+    radius = system.clearance_params[k, CL_BEARING_RADIUS]
+    return radius * nx, radius * ny
 
 
 @njit(cache=True)
@@ -77,7 +126,9 @@ def stick_row(system, k, q, qd):
     """Stick constraint v_t = G q̇ = 0 of joint k: (G's bearing block, G's journal block, Ġ q̇).
 
     G q̇ = t·(ṙ_J − ṙ_B) + (n·a_J + R_J) ω_J − (n·a_B + R_B) ω_B with a = A s the arms of the joint
-    centres, and Ġ q̇ = −φ̇ (n·ė) − ω_J² (t·a_J) + ω_B² (t·a_B), φ̇ = t·ė/|e| (docs/model.md §4).
+    centres, and Ġ q̇ = −φ̇ (n·ė) − ω_J² (t·a_J) + ω_B² (t·a_B), φ̇ = t·ė/|e| (docs/model.md §4). On a worn bore
+    R_B becomes n·r (r the bore's contact point from P_B), φ̇ the rate ψ̇ at which n turns, and Ġ q̇ gains
+    −ω_B (ψ̇ − ω_B)(t·r) (docs/model-contact.md, "Worn bores and Archard wear").
     """
     p = system.clearance_params[k]
     bearing = system.clearance_bodies[k, 0]
@@ -88,6 +139,13 @@ def stick_row(system, k, q, qd):
     ajx, ajy = frame_rotate(body_frame(q, journal), p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
     wb = body_rates(qd, bearing)[2]
     wj = body_rates(qd, journal)[2]
+    if system.wear_harmonics[k] > 0:
+        _, _, _, _, _, arm_x, arm_y, normal_turn = worn_contact(system, k, q, qd, ex, ey, dex, dey)
+        bearing_block = (-tx, -ty, -(nx * abx + ny * aby) - (nx * arm_x + ny * arm_y))
+        journal_block = (tx, ty, nx * ajx + ny * ajy + p[CL_JOURNAL_RADIUS])
+        curvature = (-normal_turn * (nx * dex + ny * dey) - wj * wj * (tx * ajx + ty * ajy)
+                     + wb * wb * (tx * abx + ty * aby) - wb * (normal_turn - wb) * (tx * arm_x + ty * arm_y))
+        return bearing_block, journal_block, curvature
     eccentricity = np.sqrt(ex * ex + ey * ey)
     orbit_rate = (tx * dex + ty * dey) / eccentricity if eccentricity > 1e-300 else 0.0
     bearing_block = (-tx, -ty, -(nx * abx + ny * aby) - p[CL_BEARING_RADIUS])
@@ -123,7 +181,8 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized):
     contact_loss = 0.0
     friction_loss = 0.0
     for k in range(system.clearance_bodies.shape[0]):
-        ex, ey, dex, dey, penetration, rate, nx, ny, sliding = clearance_kinematics(system, k, q, qd)
+        kinematics = clearance_kinematics(system, k, q, qd)
+        ex, ey, dex, dey, penetration, rate, nx, ny, sliding = kinematics
         if modes[k] == FREE and system.clearance_params[k, CL_VISCOSITY] > 0.0:
             contact_loss += add_film_forces(system, k, q, qd, generalized)
             continue
@@ -139,10 +198,35 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized):
         bx, by = point_position(q, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
         add_global_force(generalized, q, journal, bx + ex + p[CL_JOURNAL_RADIUS] * nx,
                          by + ey + p[CL_JOURNAL_RADIUS] * ny, fx, fy)
-        add_global_force(generalized, q, bearing, bx + p[CL_BEARING_RADIUS] * nx,
-                         by + p[CL_BEARING_RADIUS] * ny, -fx, -fy)
+        arm_x, arm_y = bearing_contact_arm(system, k, q, qd, kinematics)
+        add_global_force(generalized, q, bearing, bx + arm_x, by + arm_y, -fx, -fy)
         friction_loss -= ft * sliding
     return contact_loss, friction_loss
+
+
+@njit(cache=True)
+def add_wear_rates(system, q, qd, modes, impact_speeds, zdot):
+    """Write the rates of the accumulated Archard profiles (scaled by c) into their slots of ż:
+    ḣ(θ) = k_w F_n |v_t| K(θ − θ_c) / (H L R_B), θ_c the contact point's angle in the bearing frame."""
+    for k in range(system.wear_slots.shape[0]):
+        slot = system.wear_slots[k, WEAR_SLOT]
+        if slot < 0:
+            continue
+        harmonics = system.wear_slots[k, WEAR_SLOT_HARMONICS]
+        rates = zdot[slot:slot + 2 * harmonics + 1]
+        for i in range(rates.shape[0]):
+            rates[i] = 0.0
+        if modes[k] == STICK or modes[k] == FREE:
+            continue
+        kinematics = clearance_kinematics(system, k, q, qd)
+        _, _, _, _, penetration, rate, _, _, sliding = kinematics
+        fn = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], impact_speeds[k])[0]
+        if fn == 0.0:
+            continue
+        arm_x, arm_y = bearing_contact_arm(system, k, q, qd, kinematics)
+        contact_angle = np.arctan2(arm_y, arm_x) - body_pose(q, system.clearance_bodies[k, 0])[2]
+        add_kernel_rates(rates, system.wear_rates[k, 1:], harmonics,
+                         system.wear_rates[k, WEAR_SCALE] * fn * abs(sliding), contact_angle)
 
 
 MAX_FILM_ECCENTRICITY = 1.0 - 1e-9  # ε of a trial stage beyond the wall (rejected by the step control) is capped

@@ -267,7 +267,8 @@ def assemble(mechanism: schema.Mechanism, base_dir: Path | str = ".") -> System:
         degrees_of_freedom=3 * len(mechanism.bodies) - rank,
         mechanism=mechanism,
         hydraulic_cylinders=[c[0] for c in cylinders],
-        z0=np.array([z for c in cylinders for z in c[4]], float),
+        z0=np.concatenate([np.array([z for c in cylinders for z in c[4]], float),
+                           np.zeros(build.wear_state_count(arrays))]),  # an accumulated wear profile starts at 0
     )
 
 

@@ -19,6 +19,7 @@ from clearsim.model.schema import (
     DEFAULT_CONTACT, DEFAULT_LUBRICATION, FRICTION_OPTIONS, FRICTION_PARAMETERS, ContactSpec, Defaults, FrictionSpec,
     LubricationSpec,
 )
+from clearsim.physics import wear
 from clearsim.units import UnitError, contact_stiffness_to_si
 
 BUILTIN_FRICTION = FrictionSpec(law="none")
@@ -60,6 +61,20 @@ class ClearanceParameters:
     film_length: float = 0.0  # m, pin length wetted by the film
     film_model: str = "short_bearing"
     dry_below: float = 0.0  # m, film thickness below which the dry laws act (0 for a dry joint)
+    wear_profile: tuple[float, ...] = ()  # m, the worn bore's Fourier coefficients [a_0, a_1, b_1, ...]; (): circular
+    archard: ArchardNumbers | None = None  # Archard wear accumulated during the run; None: none
+
+
+@dataclass(frozen=True)
+class ArchardNumbers:
+    """Archard wear of a joint (physics/wear.py), SI."""
+
+    coefficient: float  # k_w, dimensionless
+    hardness: float  # Pa
+    length: float  # m, axial length of the worn band
+    width: float  # m, the kernel's width w = R_B/K(0) (the stated one, or the narrowest the harmonics carry)
+    harmonics: int
+    sigma: float  # rad, the kernel's σ
 
 
 def is_clearance_joint(joint) -> bool:
@@ -89,7 +104,41 @@ def resolve_clearance(joint, defaults: Defaults) -> ClearanceParameters | None:
         initial_eccentricity=_initial_eccentricity(joint, clearance),
         initial_velocity=tuple(map(float, getattr(joint, "initial_velocity", None) or (0.0, 0.0))),
         **_film_numbers(*_merged_lubrication(joint, defaults), clearance, contact.get("length")),
+        **_wear_numbers(getattr(joint, "wear", None), bearing, contact.get("length"),
+                        bool(_merged_lubrication(joint, defaults)[0].get("viscosity"))),
     )
+
+
+def _wear_numbers(spec, bearing_radius: float, pin_length: float | None, lubricated: bool) -> dict:
+    """The worn profile's coefficients (an all-zero profile is the circular bore) and the Archard numbers."""
+    if spec is None:
+        return {}
+    numbers = {}
+    if spec.profile is not None:
+        coefficients = spec.profile.coefficients()
+        if lubricated and coefficients.any():
+            raise ResolveError(("wear", "profile"), "a worn profile is not modelled under an oil film (the film "
+                               "laws assume a circular bore)", "remove the joint's lubrication or its wear profile")
+        if coefficients.any():
+            numbers["wear_profile"] = tuple(float(c) for c in coefficients)
+    if spec.archard is not None:
+        numbers["archard"] = _archard_numbers(spec.archard, bearing_radius, pin_length)
+    return numbers
+
+
+def _archard_numbers(archard, bearing_radius: float, pin_length: float | None) -> ArchardNumbers:
+    length = archard.length if archard.length is not None else pin_length
+    if length is None:
+        raise ResolveError(("wear", "archard", "length"), "Archard wear needs the length L of the worn band",
+                           "add `length: 40 mm` to the joint's wear.archard or its contact (the pin's length)")
+    narrowest = wear.narrowest_width(archard.harmonics, bearing_radius)
+    width = max(archard.width or narrowest, narrowest)
+    if width >= 2.0 * math.pi * bearing_radius:
+        raise ResolveError(("wear", "archard", "width"), f"the wear width {_mm(width)} is not shorter than the "
+                           f"bore's circumference {_mm(2.0 * math.pi * bearing_radius)}",
+                           "the width is the contact's, along the bore: a fraction of it, e.g. 2 mm")
+    return ArchardNumbers(archard.coefficient, archard.hardness, length, width, archard.harmonics,
+                          wear.kernel_sigma(width, archard.harmonics, bearing_radius))
 
 
 # --- geometry -------------------------------------------------------------------------------------

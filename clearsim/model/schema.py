@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal, Union
 
+import numpy as np
+
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, ValidationInfo, \
     WithJsonSchema, field_validator, model_validator
 
@@ -170,6 +172,87 @@ class LubricationSpec(Strict):
 DEFAULT_LUBRICATION = LubricationSpec(model="short_bearing", cavitation="half_sommerfeld", dry_below=1.5e-6)
 
 
+MEASURED_PROFILE_HARMONICS = 32  # default harmonics of a fitted measured profile (fewer when the points allow fewer)
+
+
+class WearProfile(Strict):
+    """Wear depth h(θ) = a_0 + Σ a_m cos mθ + b_m sin mθ of a bore, θ in the bearing body's frame from its x axis:
+    its coefficients (`cos`, `sin`), or measured depths (`angles`, `depth`) fitted by least squares."""
+
+    cos: list[Length] = Field([], description="[a_0, a_1, a_2, ...]: the mean depth and the cosine terms")
+    sin: list[Length] = Field([], description="[b_1, b_2, ...]: the sine terms")
+    angles: list[Angle] = Field([], description="angles θ of measured `depth` values (instead of `cos`, `sin`)")
+    depth: list[Length] = Field([], description="measured wear depths at `angles`, fitted by least squares")
+    harmonics: int | None = Field(None, ge=0, description="harmonics M of the fit to measured depths; default: "
+                                  "as many as the points allow, (N − 1)/2, at most 32")
+
+    @model_validator(mode="after")
+    def _one_form(self) -> "WearProfile":
+        if (self.cos or self.sin) and (self.angles or self.depth):
+            raise ValueError("give the profile as `cos`/`sin` coefficients or as measured `angles`/`depth`, not both")
+        if len(self.angles) != len(self.depth):
+            raise ValueError(f"{len(self.angles)} angles but {len(self.depth)} depths: give one depth per angle")
+        points = len({round(math.remainder(a, 2.0 * math.pi), 12) for a in self.angles})
+        if self.angles and 2 * self.fit_harmonics() + 1 > points:
+            raise ValueError(f"{points} distinct angles fit at most {(points - 1) // 2} harmonics, not "
+                             f"{self.fit_harmonics()}: measure more angles or lower `harmonics`")
+        return self
+
+    def fit_harmonics(self) -> int:
+        points = len(self.angles)
+        return self.harmonics if self.harmonics is not None else min((points - 1) // 2, MEASURED_PROFILE_HARMONICS)
+
+    def coefficients(self) -> np.ndarray:
+        """[a_0, a_1, b_1, ...] (m)."""
+        from clearsim.physics.wear import fitted_coefficients, profile_coefficients
+        if self.angles:
+            return fitted_coefficients(self.angles, self.depth, self.fit_harmonics())
+        return profile_coefficients(self.cos, self.sin)
+
+
+PROFILE_CHECK_POINTS = 4096  # the profile's depth is checked on this many angles (≥ 8 per period of harmonic 512)
+
+
+class ArchardWear(Strict):
+    """Archard wear accumulated over a run: V̇ = k_w F_n |v_t| / H, spread over the bore (docs/model-contact.md)."""
+
+    coefficient: float = Field(ge=0.0, description="dimensionless wear coefficient k_w (steel on steel ~1e-4)")
+    hardness: Pressure = Field(gt=0.0, description="hardness H of the worn (bearing) surface, e.g. 2 GPa")
+    length: Length | None = Field(None, gt=0.0, description="axial length L of the worn band; default: the pin's "
+                                  "`contact.length`")
+    width: Length | None = Field(None, gt=0.0, description="contact width w over which the depth rate is "
+                                 "k_w F_n |v_t| / (H L w); default and minimum: the narrowest `harmonics` carry")
+    harmonics: int = Field(64, ge=1, le=512, description="harmonics M of the accumulated profile")
+
+
+class Wear(Strict):
+    """A worn bore (`profile`) and/or Archard wear accumulated during the run (`archard`)."""
+
+    profile: WearProfile | None = Field(None, description="the bore's wear depth at the start; absent: circular")
+    wall: Length | None = Field(None, gt=0.0, description="wall thickness of the bearing: the profile may not be "
+                                "deeper")
+    archard: ArchardWear | None = Field(None, description="accumulate Archard wear during the run; absent: none")
+
+    @model_validator(mode="after")
+    def _profile_within_wall(self) -> "Wear":
+        if self.profile is None:
+            return self
+        from clearsim.physics.wear import evaluate_profile
+        angles = np.linspace(0.0, 2.0 * math.pi, PROFILE_CHECK_POINTS, endpoint=False)
+        coefficients = self.profile.coefficients()
+        depth = evaluate_profile(coefficients, angles)
+        shallowest, deepest = int(np.argmin(depth)), int(np.argmax(depth))
+        if depth[shallowest] < -1e-12 * np.abs(coefficients).sum():  # a profile touching 0 may round below it
+            raise ValueError(f"the wear profile's depth is negative ({depth[shallowest] * 1e3:.4g} mm at "
+                             f"{math.degrees(angles[shallowest]):.1f}°): wear only removes material; raise `cos[0]`, "
+                             "the mean depth, to at least the largest dip")
+        if self.wall is not None and depth[deepest] > self.wall:
+            raise ValueError(f"the wear profile is {depth[deepest] * 1e3:.4g} mm deep at "
+                             f"{math.degrees(angles[deepest]):.1f}°, deeper than the wall ({self.wall * 1e3:.4g} mm): "
+                             "check the profile's units (e.g. 0.01 mm) or the wall thickness")
+        return self
+
+
 class Defaults(Strict):
     bearing_radius: Length | None = Field(None, gt=0.0, description="bearing radius R_B of clearance joints")
     material: Material = Material()
@@ -251,6 +334,7 @@ class RevoluteJoint(Strict):
     initial_eccentricity: Point | None = Field(None, description="journal centre - bearing centre at t = 0")
     initial_velocity: tuple[Speed, Speed] | None = Field(
         None, description="velocity of the journal centre relative to the bearing centre at t = 0 (default 0)")
+    wear: Wear | None = Field(None, description="worn bore and Archard wear (a clearance joint only)")
 
 
 class PrismaticJoint(Strict):

@@ -28,6 +28,7 @@ from clearsim.assembly.dynamics import (
     WORK_OIL, WORK_ORIFICE, WORK_SUPPLY, WORK_TANK,
 )
 from clearsim.assembly.system import SensorSpec, System
+from clearsim.io.wear_results import wear_histories
 from clearsim.model import schema
 from clearsim.physics.cylindrical import POWER_LAW_CODES, max_penetrations
 from clearsim.units import UnitError, to_si
@@ -324,6 +325,7 @@ def chunk_outputs(system: System, chunk, modes: np.ndarray, initial_energy: floa
                                       system.arrays.hydraulic_params, chunk.states[:, :n],
                                       chunk.states[:, 2 * n + WORK_COUNT:])
     out |= driveline_histories(system, chunk.times, chunk.states)
+    out |= wear_histories(system, chunk.states)
     out["constraints/violation"] = (chunk.violation, "m")
     origins = sensor_origins(system)
     for spec in system.sensors:

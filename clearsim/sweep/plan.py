@@ -26,7 +26,7 @@ RESULTS = Path("results")
 MAX_CASES = 100_000  # each case is loaded and checked before anything runs (~3 ms each): 5 minutes of planning
 CASES_FILE = "cases.json"
 IDEAL_PIN_IGNORES = ("clearance", "bearing_radius", "journal_radius", "material", "contact", "friction",
-                     "initial_eccentricity", "initial_velocity")
+                     "initial_eccentricity", "initial_velocity", "wear")
 
 
 @dataclass

@@ -179,6 +179,9 @@ SIZE_CASES = {  # name: (configuration, overrides)
     "lubricated slider-crank": (CONFIGS / "slider_crank_flores.yaml",
                                 SHORT + ("joints.slider_pin.lubrication.viscosity=1e-4 Pa*s",
                                          "joints.slider_pin.lubrication.length=10 mm")),
+    "breaker wearing at J": (CONFIGS / "uhv_breaker.yaml",
+                             ("solver.t_end=5ms", "joints.J.wear={archard: {coefficient: 1e-4, hardness: 2 GPa, "
+                              "length: 40 mm}}")),
 }
 
 

@@ -1,0 +1,146 @@
+"""Worn bores and Archard wear (docs/model-contact.md, "Worn bores and Archard wear").
+
+A worn bore's wear depth over the angle θ in the bearing body's frame is a truncated Fourier series
+
+    h(θ) = a_0 + Σ_{m=1..M} (a_m cos mθ + b_m sin mθ),   coefficients stored as [a_0, a_1, b_1, a_2, b_2, ...],
+
+so the bore is the curve r(θ) = (R_B + h(θ)) u(θ), u = (cos θ, sin θ): C∞, periodic, with exact derivatives for its
+normal. The journal (radius R_J, centre e in the bearing frame) touches it at the bore point closest to e:
+θ* minimises |r(θ) − e|², found by Newton's method from the angle of e; the penetration is δ = R_J − |r(θ*) − e| and
+the contact normal n = (r(θ*) − e)/|r(θ*) − e| is the bore's local normal there (exact, not e/|e|).
+
+Archard's law gives the worn volume rate V̇ = k_w F_n |v_t| / H; it is spread over the bore with a periodic kernel
+K(φ) = (1/2π)(1 + 2 Σ g_m cos mφ), g_m = exp(−m²σ²/2) (a wrapped Gaussian truncated at M harmonics, ∫K dφ = 1):
+ḣ(θ) = V̇ K(θ − θ_c)/(L R_B), so the volume is exactly Archard's and the depth rate under the contact is
+V̇/(L w) with w = R_B/K(0) the kernel's width, σ solved from the stated width.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from scipy.optimize import brentq
+
+NEWTON_ITERATIONS = 12  # the closest bore point converges quadratically; a step below 1e-15 rad ends it earlier
+SMALLEST_SIGMA = 4.0  # σ ≥ 4/M: the truncated kernel's last weight is e^{-8} = 3e-4 of the first (no ringing)
+
+
+@njit(cache=True)
+def profile_value(coefficients, harmonics, theta):
+    """(h, h', h'') of the Fourier profile at θ (coefficients [a_0, a_1, b_1, ...], `harmonics` of them)."""
+    h, slope, curvature = coefficients[0], 0.0, 0.0
+    c1, s1 = np.cos(theta), np.sin(theta)
+    cm, sm = 1.0, 0.0
+    for m in range(1, harmonics + 1):
+        cm, sm = cm * c1 - sm * s1, sm * c1 + cm * s1  # cos mθ, sin mθ by the angle-sum recurrence
+        a, b = coefficients[2 * m - 1], coefficients[2 * m]
+        h += a * cm + b * sm
+        slope += m * (b * cm - a * sm)
+        curvature -= m * m * (a * cm + b * sm)
+    return h, slope, curvature
+
+
+@njit(cache=True)
+def closest_bore_point(coefficients, harmonics, bearing_radius, ex, ey):
+    """(θ*, r_x, r_y, r'_x, r'_y, g') of the bore point r(θ*) closest to e = (ex, ey), all in the bearing frame;
+    g' = |r'|² + (r − e)·r'' > 0 is the curvature of |r(θ) − e|²/2 at the minimum (for the rate of θ*)."""
+    theta = np.arctan2(ey, ex) if ex * ex + ey * ey > 0.0 else 0.0
+    for _ in range(NEWTON_ITERATIONS):
+        rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
+        if second <= 0.0:  # e far from the wall, near a centre of curvature (in free flight): keep θ
+            break
+        step = gradient / second
+        theta -= step
+        if abs(step) < 1e-15:
+            break
+    rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
+    return theta, rx, ry, tx, ty, second
+
+
+@njit(cache=True)
+def _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta):
+    """(r, r', g = (r − e)·r', g' = |r'|² + (r − e)·r'') at θ."""
+    h, slope, curvature = profile_value(coefficients, harmonics, theta)
+    rho = bearing_radius + h
+    c, s = np.cos(theta), np.sin(theta)
+    rx, ry = rho * c, rho * s
+    tx, ty = slope * c - rho * s, slope * s + rho * c  # r' = ρ' u + ρ u⊥
+    sx, sy = (curvature - rho) * c - 2.0 * slope * s, (curvature - rho) * s + 2.0 * slope * c  # r''
+    dx, dy = rx - ex, ry - ey
+    return rx, ry, tx, ty, dx * tx + dy * ty, tx * tx + ty * ty + dx * sx + dy * sy
+
+
+@njit(cache=True)
+def add_kernel_rates(rates, weights, harmonics, scale, theta):
+    """rates += the Fourier coefficients of scale · K(φ − θ) (K the wear kernel of `weights` g_m)."""
+    rates[0] += scale / (2.0 * np.pi)
+    c1, s1 = np.cos(theta), np.sin(theta)
+    cm, sm = 1.0, 0.0
+    for m in range(1, harmonics + 1):
+        cm, sm = cm * c1 - sm * s1, sm * c1 + cm * s1
+        rates[2 * m - 1] += scale * weights[m] * cm / np.pi
+        rates[2 * m] += scale * weights[m] * sm / np.pi
+
+
+# --- set-up (Python) ------------------------------------------------------------------------------
+
+
+def evaluate_profile(coefficients, angles) -> np.ndarray:
+    """h(θ) on an array of angles (rad), for any number of harmonics."""
+    coefficients = np.asarray(coefficients, float)
+    angles = np.asarray(angles, float)
+    depth = np.full(angles.shape, coefficients[0])
+    for m in range(1, (coefficients.shape[0] - 1) // 2 + 1):
+        depth += coefficients[2 * m - 1] * np.cos(m * angles) + coefficients[2 * m] * np.sin(m * angles)
+    return depth
+
+
+def profile_coefficients(cos: list[float], sin: list[float]) -> np.ndarray:
+    """[a_0, a_1, b_1, ...] from the YAML's `cos: [a_0, a_1, ...]` and `sin: [b_1, ...]` (missing terms 0)."""
+    harmonics = max(len(cos) - 1, len(sin), 0)
+    coefficients = np.zeros(1 + 2 * harmonics)
+    for m, a in enumerate(cos):
+        coefficients[max(2 * m - 1, 0)] = a
+    for m, b in enumerate(sin, start=1):
+        coefficients[2 * m] = b
+    return coefficients
+
+
+def fitted_coefficients(angles, depths, harmonics: int) -> np.ndarray:
+    """[a_0, a_1, b_1, ...] of the M-harmonic series nearest to measured depths (least squares; interpolation when
+    2M + 1 equals the number of distinct angles)."""
+    angles = np.asarray(angles, float)
+    columns = [np.ones_like(angles)]
+    for m in range(1, harmonics + 1):
+        columns += [np.cos(m * angles), np.sin(m * angles)]
+    return np.linalg.lstsq(np.column_stack(columns), np.asarray(depths, float), rcond=None)[0]
+
+
+def kernel_weights(sigma: float, harmonics: int) -> np.ndarray:
+    """g_m = exp(−m²σ²/2), m = 0..M."""
+    m = np.arange(harmonics + 1, dtype=float)
+    return np.exp(-0.5 * (m * sigma) ** 2)
+
+
+def kernel_width(sigma: float, harmonics: int, radius: float) -> float:
+    """w = R/K(0) of the truncated kernel: the arc length over which its peak depth would hold the whole volume."""
+    peak = (2.0 * kernel_weights(sigma, harmonics).sum() - 1.0) / (2.0 * math.pi)
+    return radius / peak
+
+
+def narrowest_width(harmonics: int, radius: float) -> float:
+    """The narrowest kernel M harmonics carry without ringing: σ = 4/M."""
+    return kernel_width(SMALLEST_SIGMA / harmonics, harmonics, radius)
+
+
+def kernel_sigma(width: float, harmonics: int, radius: float) -> float:
+    """σ of the kernel of width w (narrowest_width ≤ w < 2πR): w = R/K(0) solved to round-off."""
+    low = SMALLEST_SIGMA / harmonics
+    if width <= kernel_width(low, harmonics, radius):
+        return low
+    high = low
+    while kernel_width(high, harmonics, radius) < width and high < 1e3:  # w → 2πR as σ → ∞
+        high *= 2.0
+    return brentq(lambda s: kernel_width(s, harmonics, radius) - width, low, high, xtol=1e-300, rtol=1e-15)

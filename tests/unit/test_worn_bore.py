@@ -1,0 +1,175 @@
+"""A worn bore's contact kinematics (clearsim/physics/wear.py, assembly/forces.py) against geometry computed
+independently (tests/support/worn_bore.py): the closest point of the bore curve to the journal centre."""
+
+import numpy as np
+import pytest
+
+from clearsim.assembly.arrays import for_kernels
+from clearsim.assembly.forces import clearance_kinematics, stick_row
+from clearsim.assembly.system import assemble
+from clearsim.model.loader import load_mechanism_text
+from clearsim.physics import wear
+from tests.support.worn_bore import nearest_bore_contact
+
+BEARING_RADIUS = 0.02
+CLEARANCE = 1e-4
+JOURNAL_RADIUS = BEARING_RADIUS - CLEARANCE
+MEAN, OVAL, TILT = 3e-5, 2e-5, 5e-6  # m: h(θ) = MEAN + OVAL cos 2θ + TILT sin θ
+
+
+def depth(theta):
+    return MEAN + OVAL * np.cos(2 * theta) + TILT * np.sin(theta)
+
+
+def depth_slope(theta):
+    return -2 * OVAL * np.sin(2 * theta) + TILT * np.cos(theta)
+
+
+def depth_curvature(theta):
+    return -4 * OVAL * np.cos(2 * theta) - TILT * np.sin(theta)
+
+
+MODEL = f"""
+name: worn bore geometry
+units: SI
+points: {{O: [0 m, 0 m]}}
+bodies:
+  - {{name: sleeve, mass: 1 kg, inertia: 0.01 kg*m^2, position: [0 m, 0 m]}}
+  - {{name: pin, mass: 1 kg, inertia: 0.01 kg*m^2, position: [0 m, 0 m]}}
+joints:
+  - {{name: pivot, type: revolute, bodies: [ground, sleeve], at: O}}
+  - {{name: J, type: revolute, bodies: [sleeve, pin], at: O, bearing_radius: {BEARING_RADIUS} m,
+      clearance: {CLEARANCE} m, wear: {{profile: {{cos: [{MEAN} m, 0, {OVAL} m], sin: [{TILT} m]}}}}}}
+solver: {{t_end: 1 ms}}
+"""
+
+
+@pytest.fixture(scope="module")
+def system():
+    return for_kernels(assemble(load_mechanism_text(MODEL).mechanism).arrays)
+
+
+def profile(theta):
+    return depth(theta), depth_slope(theta), depth_curvature(theta)
+
+
+def reference_contact(local_e):
+    return nearest_bore_contact(profile, BEARING_RADIUS, JOURNAL_RADIUS, local_e)
+
+
+def journal_states(count=60, seed=3):
+    """(q, q̇) of sleeve and pin: the sleeve turned, the pin's centre near the worn wall (±3 µm) all around."""
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
+        turn = rng.uniform(-np.pi, np.pi)
+        angle = rng.uniform(-np.pi, np.pi)
+        local = (CLEARANCE + depth(angle) + rng.uniform(-3e-6, 3e-6)) * np.array([np.cos(angle), np.sin(angle)])
+        c, s = np.cos(turn), np.sin(turn)
+        centre = np.array([c * local[0] - s * local[1], s * local[0] + c * local[1]])
+        q = np.array([0.0, 0.0, turn, centre[0], centre[1], rng.uniform(-1, 1)])
+        yield q, rng.normal(size=6) * np.array([0.0, 0.0, 3.0, 0.01, 0.01, 3.0]), turn
+
+
+def test_penetration_and_normal_are_the_closest_bore_points(system):
+    tilts = []
+    for q, qd, turn in journal_states():
+        ex, ey, _, _, penetration, _, nx, ny, _ = clearance_kinematics(system, 0, q, qd)
+        c, s = np.cos(turn), np.sin(turn)
+        local_e = np.array([c * ex + s * ey, -s * ex + c * ey])
+        expected_penetration, local_normal = reference_contact(local_e)
+        expected_normal = np.array([c * local_normal[0] - s * local_normal[1], s * local_normal[0] + c * local_normal[1]])
+        assert penetration == pytest.approx(expected_penetration, abs=1e-12)
+        assert np.array([nx, ny]) * JOURNAL_RADIUS == pytest.approx(expected_normal * JOURNAL_RADIUS, abs=1e-12)
+        tilts.append(abs(expected_normal[0] * ey - expected_normal[1] * ex) / np.hypot(ex, ey))
+    assert max(tilts) > 1e-3  # the worn normal is not e/|e|: the test tells the two apart
+
+
+def along(function, q, qd, step=1e-6):
+    """d/dt of function(q) along q̇ (central difference)."""
+    return (function(q + step * qd) - function(q - step * qd)) / (2 * step)
+
+
+def test_rates_are_the_time_derivatives_of_the_geometry(system):
+    """δ̇ = dδ/dt, and the stick row: G q̇ = v_t and Ġ q̇ = d(G)/dt q̇ on the worn bore."""
+    for q, qd, _ in journal_states(20, seed=5):
+        rate = clearance_kinematics(system, 0, q, qd)[5]
+        assert rate == pytest.approx(along(lambda x: clearance_kinematics(system, 0, x, qd)[4], q, qd), rel=1e-6,
+                                     abs=1e-12)
+
+        def g_times(x, velocity):
+            bearing, journal, _ = stick_row(system, 0, x, qd)
+            return np.dot(bearing, velocity[:3]) + np.dot(journal, velocity[3:])
+
+        sliding = clearance_kinematics(system, 0, q, qd)[8]
+        assert g_times(q, qd) == pytest.approx(sliding, rel=1e-12, abs=1e-15)
+        curvature = stick_row(system, 0, q, qd)[2]
+        assert curvature == pytest.approx(along(lambda x: g_times(x, qd), q, qd), rel=1e-5, abs=1e-9)
+
+
+def test_a_circular_profile_gives_the_circular_kinematics():
+    """A worn profile of constant depth h is a circular bore of clearance c + h (the worn branch against the
+    circular one)."""
+    worn = for_kernels(assemble(load_mechanism_text(MODEL.replace(f"{OVAL} m]", "0 m]").replace(
+        f"sin: [{TILT} m]", "sin: [0 m]")).mechanism).arrays)
+    round_model = MODEL.replace(f"clearance: {CLEARANCE} m", f"clearance: {CLEARANCE + MEAN} m, "
+                                f"journal_radius: {JOURNAL_RADIUS} m").replace(f"bearing_radius: {BEARING_RADIUS} m,", "")
+    round_model = round_model[:round_model.index(", wear:")] + "}\nsolver: {t_end: 1 ms}\n"
+    circular = for_kernels(assemble(load_mechanism_text(round_model).mechanism).arrays)
+    for q, qd, _ in journal_states(20, seed=7):
+        assert np.array(clearance_kinematics(worn, 0, q, qd)) == pytest.approx(
+            np.array(clearance_kinematics(circular, 0, q, qd)), rel=1e-9, abs=1e-13)
+
+
+def test_profile_coefficients_evaluate_as_written():
+    coefficients = wear.profile_coefficients([MEAN, 0.0, OVAL], [TILT])
+    angles = np.linspace(0, 2 * np.pi, 37)
+    assert wear.evaluate_profile(coefficients, angles) == pytest.approx(depth(angles), abs=1e-18)
+    for theta in angles:
+        assert wear.profile_value(coefficients, 2, theta) == pytest.approx(
+            (depth(theta), depth_slope(theta), depth_curvature(theta)), abs=1e-16)
+
+
+@pytest.mark.parametrize("width", [0.004, 0.01, 0.05])
+def test_the_wear_kernel_has_the_stated_width_and_unit_volume(width):
+    """w = R/K(0) to round-off, ∫K dθ = 1 (its a_0 is 1/2π), and the series is non-negative within its ringing."""
+    harmonics = 64
+    sigma = wear.kernel_sigma(width, harmonics, BEARING_RADIUS)
+    rates = np.zeros(2 * harmonics + 1)
+    wear.add_kernel_rates(rates, wear.kernel_weights(sigma, harmonics), harmonics, 1.0, 0.7)
+    angles = np.linspace(0, 2 * np.pi, 4000, endpoint=False)
+    kernel = wear.evaluate_profile(rates, angles)
+    assert rates[0] == pytest.approx(1 / (2 * np.pi), rel=1e-15)
+    assert wear.evaluate_profile(rates, [0.7])[0] == pytest.approx(BEARING_RADIUS / width, rel=1e-12)
+    assert angles[np.argmax(kernel)] == pytest.approx(0.7, abs=2 * np.pi / 4000)
+    assert kernel.min() > -1e-4 * kernel.max()
+
+
+@pytest.mark.parametrize("harmonics", [8, 64, 512])
+def test_the_narrowest_kernel_hardly_rings(harmonics):
+    """σ = 4/M: the truncated series' negative lobes stay below 1e-4 of its peak; a narrower width is raised to it."""
+    narrowest = wear.narrowest_width(harmonics, BEARING_RADIUS)
+    assert wear.kernel_sigma(0.1 * narrowest, harmonics, BEARING_RADIUS) == wear.SMALLEST_SIGMA / harmonics
+    rates = np.zeros(2 * harmonics + 1)
+    weights = wear.kernel_weights(wear.SMALLEST_SIGMA / harmonics, harmonics)
+    wear.add_kernel_rates(rates, weights, harmonics, 1.0, 0.3)
+    kernel = wear.evaluate_profile(rates, np.linspace(0, 2 * np.pi, 20000, endpoint=False))
+    assert kernel.min() > -1e-4 * kernel.max()
+    assert narrowest == pytest.approx(np.sqrt(2 * np.pi) * BEARING_RADIUS * 4 / harmonics, rel=1e-3)
+
+
+def test_a_measured_profile_is_fitted_to_its_series():
+    """Depths measured at 12 angles of a profile with 2 harmonics give back its coefficients (least squares)."""
+    angles = np.radians(np.arange(0, 360, 30))
+    text = MODEL.replace(f"profile: {{cos: [{MEAN} m, 0, {OVAL} m], sin: [{TILT} m]}}",
+                         f"profile: {{angles: [{', '.join(f'{a} rad' for a in angles)}], "
+                         f"depth: [{', '.join(f'{d} m' for d in depth(angles))}], harmonics: 2}}")
+    fitted = assemble(load_mechanism_text(text).mechanism).arrays.wear_profile[0]
+    assert fitted == pytest.approx([MEAN, 0.0, TILT, OVAL, 0.0], abs=1e-18)
+
+
+def test_a_centred_journal_has_finite_kinematics(system):
+    """At the centre of an oval bore (the start of a run) the nearest-point search has no minimum to converge to; the
+    kinematics stay finite and far from contact."""
+    kinematics = clearance_kinematics(system, 0, np.zeros(6), np.array([0.0, 0.0, 1.0, 1e-3, -1e-3, 2.0]))
+    assert np.all(np.isfinite(kinematics)) and kinematics[4] < -CLEARANCE
+    assert np.all(np.isfinite(stick_row(system, 0, np.zeros(6), np.ones(6))[2]))

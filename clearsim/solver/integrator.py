@@ -47,6 +47,7 @@ from clearsim.assembly.forces import (
 from clearsim.physics.contact import HERTZ_CONTACT_TIME_FACTOR
 from clearsim.physics.cylindrical import is_power_law, law_max_penetration
 from clearsim.physics.friction import static_coefficient
+from clearsim.solver import rosenbrock
 from clearsim.solver.dopri import STAGES, error_norm, interpolate, step
 from clearsim.solver.samples import derive_sample
 
@@ -60,7 +61,12 @@ REAL_SLOTS = 17
 # int_state slots
 (I_STATUS, I_STEPS, I_REJECTED, I_RHS, I_EVENTS, I_SAMPLES, I_NEXT_SAMPLE, I_FAIL_JOINT, I_LOG, I_TOTAL_SAMPLES,
  I_FRICTION_EVENTS, I_STALLED, I_COARSE, I_COARSE_JOINT) = range(14)
-INT_SLOTS = 14
+# the integration method (METHODS) and, for ROSENBROCK, the accepted steps its Jacobian has served (−1: none yet, or
+# one to take anew: rosenbrock.jacobian_is_stale)
+I_METHOD, I_JACOBIAN_AGE = 14, 15
+INT_SLOTS = 16
+DOPRI5, ROSENBROCK = range(2)
+METHODS = {"dopri5": DOPRI5, "rosenbrock": ROSENBROCK}
 
 RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END, CHATTER, FIRST_STEP, PAUSED = range(11)
 # PAUSED: STEPS_PER_CALL steps tried since the call began; call again (Ctrl-C and the progress bar are handled in
@@ -454,7 +460,27 @@ def update_output_peak(n, y, f, real):
 
 
 @njit(cache=True, inline="always")
-def refine_event(system, dynamics, projection, k, kind, t, y, f, h_event, modes, speeds, stages, y_event, ints):
+def method_step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, ints, jacobian):
+    """One step of the run's method (ints[I_METHOD]); returns (the error vector, the rhs evaluations made)."""
+    if ints[I_METHOD] == ROSENBROCK:
+        return rosenbrock.step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian)
+    return step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new), 6
+
+
+@njit(cache=True, inline="always")
+def refresh_jacobian(system, dynamics, t, y, f, h, modes, speeds, real, ints, jacobian, jacobian_modes):
+    """ROSENBROCK: take J (and ∂f/∂t) anew at (t, y) when the one held is stale (rosenbrock.jacobian_is_stale)."""
+    if ints[I_METHOD] != ROSENBROCK or not rosenbrock.jacobian_is_stale(ints[I_JACOBIAN_AGE], modes, jacobian_modes):
+        return
+    n = coordinate_count(system)
+    ints[I_RHS] += rosenbrock.evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, 2 * n, WORK_COUNT,
+                                                real[R_ATOL] / real[R_RTOL], jacobian, jacobian_modes)
+    ints[I_JACOBIAN_AGE] = 0
+
+
+@njit(cache=True, inline="always")
+def refine_event(system, dynamics, projection, k, kind, t, y, f, h_event, modes, speeds, stages, y_event, ints,
+                 jacobian):
     """Integrate from t exactly to joint k's event; returns the step length.
 
     NORMAL events: Newton on the step length until |δ| < 1e-3 ε. TANGENTIAL events: the dense-output
@@ -462,8 +488,8 @@ def refine_event(system, dynamics, projection, k, kind, t, y, f, h_event, modes,
     """
     tolerance = 1e-3 * hysteresis(system, k)
     for _ in range(6):
-        step(system, dynamics, t, y, f, h_event, modes, speeds, stages, y_event)
-        ints[I_RHS] += 6
+        ints[I_RHS] += method_step(system, dynamics, t, y, f, h_event, modes, speeds, stages, y_event, ints,
+                                   jacobian)[1]
         projection(system, t + h_event, y_event, modes)
         if kind == TANGENTIAL:
             break
@@ -476,7 +502,7 @@ def refine_event(system, dynamics, projection, k, kind, t, y, f, h_event, modes,
 
 @njit(cache=True)
 def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, speeds, episode_of, log_joint,
-            log_onset, log_loss, log_speed, log_mass, peak_force, out_t, out_y, out_modes, out_speeds, out_episode,
+            log_onset, log_loss, log_speed, log_mass, peak_force, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode,
             out_qdd, out_lam, out_contact, out_energies, t_stop):
     """Integrate until t_stop, the end, a full buffer, STEPS_PER_CALL tried steps or a failure; the status is
     ints[I_STATUS]."""
@@ -487,6 +513,8 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
     ints[I_STATUS] = RUNNING
     capacity = out_t.shape[0]
     attempts = 0
+    # the step-size controller's exponent: −1/(q + 1) for the embedded order q
+    exponent = -1.0 / (rosenbrock.EMBEDDED_ORDER + 1) if ints[I_METHOD] == ROSENBROCK else -0.2
     if real[R_STEP] <= 0.0:
         rhs(system, dynamics, real[R_TIME], y, modes, speeds, f)
         ints[I_STATUS] = FIRST_STEP
@@ -523,8 +551,9 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
                 ints[I_STATUS] = BUFFER_FULL
                 return
             h = (capacity - 2) * real[R_SAMPLE_DT]
-        error = step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new)
-        ints[I_RHS] += 6
+        refresh_jacobian(system, dynamics, t, y, f, h, modes, speeds, real, ints, jacobian, jacobian_modes)
+        error, evaluations = method_step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, ints, jacobian)
+        ints[I_RHS] += evaluations
         norm = error_norm(error, y, y_new, 2 * n, WORK_COUNT, real[R_RTOL], real[R_ATOL])
         if not np.isfinite(norm):
             norm = 1e10
@@ -533,14 +562,17 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
             if h <= real[R_MIN_STEP] * (1.0 + 1e-12):
                 ints[I_STATUS] = MIN_STEP
                 return
-            real[R_STEP] = max(h * max(0.2, SAFETY * norm ** -0.2), real[R_MIN_STEP])
+            real[R_STEP] = max(h * max(0.2, SAFETY * norm ** exponent), real[R_MIN_STEP])
+            if ints[I_JACOBIAN_AGE] > 0:  # a Jacobian that has served accepted steps may be what failed: take it anew
+                ints[I_JACOBIAN_AGE] = -1
             continue
-        real[R_STEP] = h * min(10.0, max(0.2, SAFETY * norm ** -0.2)) if norm > 0.0 else 10.0 * h
+        real[R_STEP] = h * min(10.0, max(0.2, SAFETY * norm ** exponent)) if norm > 0.0 else 10.0 * h
+        ints[I_JACOBIAN_AGE] += 1
         event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, modes, speeds,
                                                               scratch)
         if event_joint >= 0:
             h = refine_event(system, dynamics, projection, event_joint, event_kind, t, y, f, event_theta * h, modes,
-                             speeds, stages, y_new, ints)
+                             speeds, stages, y_new, ints, jacobian)
         emit_samples(system, dynamics, projection, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints,
                      out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
                      scratch)

@@ -502,8 +502,8 @@ def refine_event(system, dynamics, projection, k, kind, t, y, f, h_event, modes,
 
 @njit(cache=True)
 def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, speeds, episode_of, log_joint,
-            log_onset, log_loss, log_speed, log_mass, peak_force, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode,
-            out_qdd, out_lam, out_contact, out_energies, t_stop):
+            log_onset, log_loss, log_speed, log_mass, peak_force, jacobian, jacobian_modes, out_t, out_y, out_modes,
+            out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, t_stop):
     """Integrate until t_stop, the end, a full buffer, STEPS_PER_CALL tried steps or a failure; the status is
     ints[I_STATUS]."""
     n = coordinate_count(system)

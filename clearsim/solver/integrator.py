@@ -239,9 +239,9 @@ def projection_type(system_type):
 
 
 @njit(cache=True, inline="always")
-def emit_samples(system, dynamics, projection, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints,
-                 out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
-                 scratch):
+def emit_samples(system, dynamics, projection, t, y, f, stages, h, t_next, modes, speeds, episode_of, real, ints,
+                 jacobian, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact,
+                 out_energies, scratch):
     """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives
     from them (derive_sample)."""
     dt = real[R_SAMPLE_DT]
@@ -250,7 +250,12 @@ def emit_samples(system, dynamics, projection, t, y, stages, h, t_next, modes, s
         if sample_time > t_next:
             break
         row = ints[I_SAMPLES]
-        if h > 0.0:
+        if h > 0.0 and ints[I_METHOD] == ROSENBROCK and t < sample_time < t + h:
+            # a step of its own to the sample: the Hermite extension is not damped like the step (model.md §4)
+            rosenbrock.step(system, dynamics, t, y, f, sample_time - t, modes, speeds, np.empty_like(stages), scratch,
+                            jacobian)
+            ints[I_RHS] += rosenbrock.STAGES
+        elif h > 0.0:
             interpolate(y, stages, h, (sample_time - t) / h, scratch)
         else:
             copy_into(scratch, y)
@@ -541,8 +546,8 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
             ints[I_RHS] += 1
             real[R_STEP] = min(real[R_STEP], switched)
         if ints[I_NEXT_SAMPLE] == 0:  # the first sample, in the modes the initial state has
-            emit_samples(system, dynamics, projection, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints,
-                         out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
+            emit_samples(system, dynamics, projection, t, y, f, stages, 0.0, t, modes, speeds, episode_of, real, ints,
+                         jacobian, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
                          scratch)
         h = min(real[R_STEP], real[R_MAX_STEP], real[R_T_END] - t, free_flight_limit(system, y, modes))
         h = max(h, real[R_MIN_STEP])
@@ -573,8 +578,8 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
         if event_joint >= 0:
             h = refine_event(system, dynamics, projection, event_joint, event_kind, t, y, f, event_theta * h, modes,
                              speeds, stages, y_new, ints, jacobian)
-        emit_samples(system, dynamics, projection, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints,
-                     out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
+        emit_samples(system, dynamics, projection, t, y, f, stages, h, t + h, modes, speeds, episode_of, real, ints,
+                     jacobian, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
                      scratch)
         if event_joint < 0:  # projected after the samples: the step end's factor then serves its rhs below
             violation = projection(system, t + h, y_new, modes)

@@ -8,10 +8,6 @@ import hashlib
 import numpy as np
 import pytest
 
-from clearsim.io.hdf5 import read_result
-from clearsim.model.loader import load_mechanism, load_mechanism_text
-from clearsim.runner import prepare, run_to_file
-from tests.validation.conftest import CONFIGS
 from tests.validation.test_ideal_kinematics import closed_form
 from tests.validation.test_lubricated_joint import CLEARANCE, eccentricity_ratio, journal, squeeze_time
 
@@ -29,24 +25,6 @@ forces:
 solver: {{t_end: 200 ms, output_rate: 1 kHz, rtol: 0.5, atol: 1, max_step: {step} ms, initial_step: {step} ms,
           method: {method}}}
 """
-
-
-@pytest.fixture
-def simulate_with_statistics(tmp_path):
-    """(the result file's datasets, the run's Statistics) of a config (bundled name or YAML text) with overrides."""
-    counter = iter(range(10**6))
-
-    def run(source: str, *overrides: str):
-        if source.endswith(".yaml") and "\n" not in source:
-            loaded = load_mechanism(CONFIGS / source, overrides)
-        else:
-            loaded = load_mechanism_text(source, overrides=overrides)
-        output = tmp_path / f"run{next(counter)}.h5"
-        report = run_to_file(prepare(loaded), loaded, output)
-        assert report.complete, report.status
-        return read_result(output), report.statistics
-
-    return run
 
 
 def block_position(t):

@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit
 
 from clearsim.assembly.arrays import copy_into
-from clearsim.assembly.dynamics import rhs
+from clearsim.assembly.dynamics import WORK_COUNT, coordinate_count, rhs
 from clearsim.solver import dopri
 
 STAGES = 4
@@ -103,6 +103,24 @@ def evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, skipped_from,
         jacobian[i, ny] = (column[i] - f[i]) / increment
     copy_into(jacobian_modes, modes)
     return count + 1
+
+
+@njit(cache=True)
+def jacobian_evaluations(y):
+    """The rhs evaluations evaluate_jacobian makes for a state like y: one per column but the integrated powers', and
+    one for ∂f/∂t."""
+    return y.shape[0] - WORK_COUNT + 1
+
+
+@njit(cache=True)
+def attempt(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian, jacobian_modes, take_jacobian, floor):
+    """One step (step) from (t, y), J and ∂f/∂t taken anew at (t, y) first when take_jacobian (evaluate_jacobian, the
+    increments' floor `floor`); returns the error vector. The loop calls it by address (integrator.addressed_kernels),
+    so that it is compiled on its own and not into the loop."""
+    if take_jacobian:
+        evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, 2 * coordinate_count(system), WORK_COUNT, floor,
+                          jacobian, jacobian_modes)
+    return step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian)[0]
 
 
 @njit(cache=True)

@@ -18,8 +18,9 @@ Python (progress bar, writing, Ctrl-C); all its state lives in the arrays of `Ru
 at the top of the loop changes no result (tested with a return every 7 steps: every result file bitwise equal).
 
 Compile time (docs/performance.md): numba compiles every kernel it calls as a library of its own,
-with all its callees linked in and optimised again. So three kernels are called by address: `advance` takes
-the mode switch, the projection and the model's dynamics (forces and constrained accelerations) as arguments
+with all its callees linked in and optimised again. So four kernels are called by address: `advance` takes
+the mode switch, the projection, the model's dynamics (forces and constrained accelerations) and the Rosenbrock
+step (solver.method: rosenbrock; linked into the loop it added ~10 s to a compile on an empty cache) as arguments
 typed as function types (`addressed_kernels`, `compiled_loop`) and passes the projection and the dynamics on to
 the kernels that need them. Each is then compiled once, not into every library above it, and none has to be
 compiled before `advance` is typed, so on an empty cache a second process compiles them meanwhile
@@ -47,6 +48,7 @@ from clearsim.assembly.forces import (
 from clearsim.physics.contact import HERTZ_CONTACT_TIME_FACTOR
 from clearsim.physics.cylindrical import is_power_law, law_max_penetration
 from clearsim.physics.friction import static_coefficient
+from clearsim.solver import rosenbrock
 from clearsim.solver.dopri import STAGES, error_norm, interpolate, step
 from clearsim.solver.samples import derive_sample
 
@@ -60,7 +62,12 @@ REAL_SLOTS = 17
 # int_state slots
 (I_STATUS, I_STEPS, I_REJECTED, I_RHS, I_EVENTS, I_SAMPLES, I_NEXT_SAMPLE, I_FAIL_JOINT, I_LOG, I_TOTAL_SAMPLES,
  I_FRICTION_EVENTS, I_STALLED, I_COARSE, I_COARSE_JOINT) = range(14)
-INT_SLOTS = 14
+# the integration method (METHODS) and, for ROSENBROCK, the accepted steps its Jacobian has served (−1: none yet, or
+# one to take anew: rosenbrock.jacobian_is_stale)
+I_METHOD, I_JACOBIAN_AGE = 14, 15
+INT_SLOTS = 16
+DOPRI5, ROSENBROCK = range(2)
+METHODS = {"dopri5": DOPRI5, "rosenbrock": ROSENBROCK}
 
 RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END, CHATTER, FIRST_STEP, PAUSED = range(11)
 # PAUSED: STEPS_PER_CALL steps tried since the call began; call again (Ctrl-C and the progress bar are handled in
@@ -233,9 +240,9 @@ def projection_type(system_type):
 
 
 @njit(cache=True, inline="always")
-def emit_samples(system, dynamics, projection, t, y, stages, h, t_next, modes, speeds, episode_of, real, ints,
-                 out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
-                 scratch):
+def emit_samples(system, dynamics, projection, implicit_step, t, y, f, stages, h, t_next, modes, speeds, episode_of,
+                 real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact,
+                 out_energies, scratch):
     """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives
     from them (derive_sample)."""
     dt = real[R_SAMPLE_DT]
@@ -244,7 +251,11 @@ def emit_samples(system, dynamics, projection, t, y, stages, h, t_next, modes, s
         if sample_time > t_next:
             break
         row = ints[I_SAMPLES]
-        if h > 0.0:
+        if h > 0.0 and ints[I_METHOD] == ROSENBROCK and t < sample_time < t + h:
+            # a step of its own to the sample: the Hermite extension is not damped like the step (model.md §4)
+            ints[I_RHS] += method_step(system, dynamics, implicit_step, t, y, f, sample_time - t, modes, speeds,
+                                       np.empty_like(stages), scratch, real, ints, jacobian, jacobian_modes, False)[1]
+        elif h > 0.0:
             interpolate(y, stages, h, (sample_time - t) / h, scratch)
         else:
             copy_into(scratch, y)
@@ -454,7 +465,27 @@ def update_output_peak(n, y, f, real):
 
 
 @njit(cache=True, inline="always")
-def refine_event(system, dynamics, projection, k, kind, t, y, f, h_event, modes, speeds, stages, y_event, ints):
+def method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stages, y_new, real, ints, jacobian,
+                jacobian_modes, take_jacobian):
+    """One step of the run's method (ints[I_METHOD]); ROSENBROCK: by address (rosenbrock.attempt), J taken anew first
+    when take_jacobian. Returns (the error vector, the rhs evaluations made)."""
+    if ints[I_METHOD] == ROSENBROCK:
+        error = implicit_step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian, jacobian_modes,
+                              take_jacobian, real[R_ATOL] / real[R_RTOL])
+        taken = rosenbrock.jacobian_evaluations(y) if take_jacobian else 0
+        return error, rosenbrock.STAGES + taken
+    return step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new), 6
+
+
+@njit(cache=True, inline="always")
+def jacobian_due(ints, modes, jacobian_modes):
+    """ROSENBROCK: the Jacobian held is stale (rosenbrock.jacobian_is_stale): the next step takes it anew."""
+    return ints[I_METHOD] == ROSENBROCK and rosenbrock.jacobian_is_stale(ints[I_JACOBIAN_AGE], modes, jacobian_modes)
+
+
+@njit(cache=True, inline="always")
+def refine_event(system, dynamics, projection, implicit_step, k, kind, t, y, f, h_event, modes, speeds, stages, y_event,
+                 real, ints, jacobian, jacobian_modes):
     """Integrate from t exactly to joint k's event; returns the step length.
 
     NORMAL events: Newton on the step length until |δ| < 1e-3 ε. TANGENTIAL events: the dense-output
@@ -462,8 +493,8 @@ def refine_event(system, dynamics, projection, k, kind, t, y, f, h_event, modes,
     """
     tolerance = 1e-3 * hysteresis(system, k)
     for _ in range(6):
-        step(system, dynamics, t, y, f, h_event, modes, speeds, stages, y_event)
-        ints[I_RHS] += 6
+        ints[I_RHS] += method_step(system, dynamics, implicit_step, t, y, f, h_event, modes, speeds, stages, y_event,
+                                   real, ints, jacobian, jacobian_modes, False)[1]
         projection(system, t + h_event, y_event, modes)
         if kind == TANGENTIAL:
             break
@@ -475,9 +506,9 @@ def refine_event(system, dynamics, projection, k, kind, t, y, f, h_event, modes,
 
 
 @njit(cache=True)
-def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, speeds, episode_of, log_joint,
-            log_onset, log_loss, log_speed, log_mass, peak_force, out_t, out_y, out_modes, out_speeds, out_episode,
-            out_qdd, out_lam, out_contact, out_energies, t_stop):
+def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real, ints, modes, speeds, episode_of, log_joint,
+            log_onset, log_loss, log_speed, log_mass, peak_force, jacobian, jacobian_modes, out_t, out_y, out_modes,
+            out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, t_stop):
     """Integrate until t_stop, the end, a full buffer, STEPS_PER_CALL tried steps or a failure; the status is
     ints[I_STATUS]."""
     n = coordinate_count(system)
@@ -487,6 +518,8 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
     ints[I_STATUS] = RUNNING
     capacity = out_t.shape[0]
     attempts = 0
+    # the step-size controller's exponent: −1/(q + 1) for the embedded order q
+    exponent = -1.0 / (rosenbrock.EMBEDDED_ORDER + 1) if ints[I_METHOD] == ROSENBROCK else -0.2
     if real[R_STEP] <= 0.0:
         rhs(system, dynamics, real[R_TIME], y, modes, speeds, f)
         ints[I_STATUS] = FIRST_STEP
@@ -513,8 +546,8 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
             ints[I_RHS] += 1
             real[R_STEP] = min(real[R_STEP], switched)
         if ints[I_NEXT_SAMPLE] == 0:  # the first sample, in the modes the initial state has
-            emit_samples(system, dynamics, projection, t, y, stages, 0.0, t, modes, speeds, episode_of, real, ints,
-                         out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
+            emit_samples(system, dynamics, projection, implicit_step, t, y, f, stages, 0.0, t, modes, speeds,
+                         episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
                          scratch)
         h = min(real[R_STEP], real[R_MAX_STEP], real[R_T_END] - t, free_flight_limit(system, y, modes))
         h = max(h, real[R_MIN_STEP])
@@ -523,8 +556,12 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
                 ints[I_STATUS] = BUFFER_FULL
                 return
             h = (capacity - 2) * real[R_SAMPLE_DT]
-        error = step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new)
-        ints[I_RHS] += 6
+        take_jacobian = jacobian_due(ints, modes, jacobian_modes)
+        error, evaluations = method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stages, y_new, real,
+                                         ints, jacobian, jacobian_modes, take_jacobian)
+        ints[I_RHS] += evaluations
+        if take_jacobian:
+            ints[I_JACOBIAN_AGE] = 0
         norm = error_norm(error, y, y_new, 2 * n, WORK_COUNT, real[R_RTOL], real[R_ATOL])
         if not np.isfinite(norm):
             norm = 1e10
@@ -533,16 +570,19 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
             if h <= real[R_MIN_STEP] * (1.0 + 1e-12):
                 ints[I_STATUS] = MIN_STEP
                 return
-            real[R_STEP] = max(h * max(0.2, SAFETY * norm ** -0.2), real[R_MIN_STEP])
+            real[R_STEP] = max(h * max(0.2, SAFETY * norm ** exponent), real[R_MIN_STEP])
+            if ints[I_JACOBIAN_AGE] > 0:  # a Jacobian that has served accepted steps may be what failed: take it anew
+                ints[I_JACOBIAN_AGE] = -1
             continue
-        real[R_STEP] = h * min(10.0, max(0.2, SAFETY * norm ** -0.2)) if norm > 0.0 else 10.0 * h
+        real[R_STEP] = h * min(10.0, max(0.2, SAFETY * norm ** exponent)) if norm > 0.0 else 10.0 * h
+        ints[I_JACOBIAN_AGE] += 1
         event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, modes, speeds,
                                                               scratch)
         if event_joint >= 0:
-            h = refine_event(system, dynamics, projection, event_joint, event_kind, t, y, f, event_theta * h, modes,
-                             speeds, stages, y_new, ints)
-        emit_samples(system, dynamics, projection, t, y, stages, h, t + h, modes, speeds, episode_of, real, ints,
-                     out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
+            h = refine_event(system, dynamics, projection, implicit_step, event_joint, event_kind, t, y, f,
+                             event_theta * h, modes, speeds, stages, y_new, real, ints, jacobian, jacobian_modes)
+        emit_samples(system, dynamics, projection, implicit_step, t, y, f, stages, h, t + h, modes, speeds,
+                     episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
                      scratch)
         if event_joint < 0:  # projected after the samples: the step end's factor then serves its rhs below
             violation = projection(system, t + h, y_new, modes)
@@ -577,7 +617,7 @@ def advance(system, mode_switch, projection, dynamics, y, f, real, ints, modes, 
 
 
 # the kernels `advance` takes by address, in its argument order (addressed_kernels)
-ADDRESSED = (switch_mode, project_state, forces_and_accelerations)
+ADDRESSED = (switch_mode, project_state, forces_and_accelerations, rosenbrock.attempt)
 
 
 def addressed_kernels(system_type) -> list:
@@ -588,9 +628,10 @@ def addressed_kernels(system_type) -> list:
     loop's first call numba compiles or loads each one as it converts the argument, in this order; the compile-ahead
     helper takes them in the reverse order (precompile.kernels_ahead), the largest first, so that on an empty cache
     the two processes share them and meet in the middle."""
-    F, I, V, IV = types.float64, types.int64, types.float64[::1], types.int64[::1]
+    F, I, V, IV, M = types.float64, types.int64, types.float64[::1], types.int64[::1], types.float64[:, ::1]
     dynamics, projection = dynamics_type(system_type), projection_type(system_type)
     signature = {
+        rosenbrock.attempt: V(system_type, dynamics, F, V, V, F, IV, V, M, V, M, IV, types.boolean, F),
         switch_mode: F(system_type, dynamics, projection, I, I, F, V, IV, V, IV, V, IV, IV, V, V, V, V),
         project_state: projection.signature,
         forces_and_accelerations: dynamics.signature,

@@ -226,6 +226,12 @@ class Run:
         self.peak_force = np.zeros(nc)
         self.real = np.zeros(ig.REAL_SLOTS)
         self.ints = np.zeros(ig.INT_SLOTS, np.int64)
+        self.ints[ig.I_METHOD] = ig.METHODS[settings.method]
+        self.ints[ig.I_JACOBIAN_AGE] = -1
+        # rosenbrock: ∂f/∂y and ∂f/∂t (last column), and the contact modes it was taken in
+        size = self.y.size if settings.method == "rosenbrock" else 0
+        self.jacobian = np.zeros((size, size + 1))
+        self.jacobian_modes = np.zeros(nc, np.int64)
         dt = 1.0 / output_rate(system)
         self.real[[ig.R_T_END, ig.R_RTOL, ig.R_ATOL, ig.R_MAX_STEP, ig.R_MIN_STEP, ig.R_SAMPLE_DT]] = (
             settings.t_end, settings.rtol, settings.atol, settings.max_step, settings.min_step, dt)
@@ -290,7 +296,8 @@ class Run:
     def _advance(self, t_stop: float) -> None:
         started = clock.perf_counter()
         arguments = ig.loop_arguments(self.kernel_arrays, self.y, self.f, self.real, self.ints, self.modes, self.speeds,
-                                      self.episode_of, *self.log, self.peak_force, *self.buffers, t_stop)
+                                      self.episode_of, *self.log, self.peak_force, self.jacobian, self.jacobian_modes,
+                                      *self.buffers, t_stop)
         loop = ig.compiled_loop(arguments)
         precompile.compile_addressed(self.kernel_arrays)  # once per process, before the loop's first call
         loop(*arguments)

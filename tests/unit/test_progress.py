@@ -35,15 +35,17 @@ def test_chunk_span_follows_the_pace_within_its_limits():
     assert sim.chunk_span(finest, 1.0, 1e-9, 10.0) == finest  # a crawling pace: never below 1 % of t_end
 
 
-def test_where_the_loop_returns_does_not_change_the_result(monkeypatch):
+@pytest.mark.parametrize("method", ["dopri5", "rosenbrock"])
+def test_where_the_loop_returns_does_not_change_the_result(monkeypatch, method):
     """The loop pauses between steps, so returning every 1 % of t_end or once per full sample buffer gives the same
-    run, bit for bit (3 ms of the slider-crank: its first impacts, contact episodes and their events)."""
+    run, bit for bit (3 ms of the slider-crank: its first impacts, contact episodes and their events), with either
+    method (rosenbrock's Jacobian and its age live in the run's arrays)."""
     from dataclasses import fields
 
     from clearsim.model.loader import load_mechanism
     from clearsim.runner import prepare
 
-    loaded = load_mechanism(SLIDER_CRANK, ["solver.t_end=3ms"])
+    loaded = load_mechanism(SLIDER_CRANK, ["solver.t_end=3ms", f"solver.method={method}"])
     runs = {}
     for pace in (0.0, 1e9):
         monkeypatch.setattr(sim, "PROGRESS_SECONDS", pace)

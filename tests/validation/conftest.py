@@ -12,11 +12,12 @@ CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
 
 
 @pytest.fixture
-def simulate(tmp_path):
-    """simulate(config_name_or_yaml_text, *overrides) → dict of the result file's datasets."""
+def simulate_with_statistics(tmp_path):
+    """simulate_with_statistics(config_name_or_yaml_text, *overrides) → (dict of the result file's datasets, the
+    run's Statistics)."""
     counter = iter(range(10**6))
 
-    def run(source: str, *overrides: str) -> dict:
+    def run(source: str, *overrides: str) -> tuple[dict, object]:
         if source.endswith(".yaml") and "\n" not in source:
             loaded = load_mechanism(CONFIGS / source, overrides)
         else:
@@ -24,9 +25,15 @@ def simulate(tmp_path):
         output = tmp_path / f"run{next(counter)}.h5"
         report = run_to_file(prepare(loaded), loaded, output)
         assert report.complete, report.status
-        return read_result(output)
+        return read_result(output), report.statistics
 
     return run
+
+
+@pytest.fixture
+def simulate(simulate_with_statistics):
+    """simulate(config_name_or_yaml_text, *overrides) → dict of the result file's datasets."""
+    return lambda source, *overrides: simulate_with_statistics(source, *overrides)[0]
 
 
 @pytest.fixture(scope="module")

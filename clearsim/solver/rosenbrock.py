@@ -1,0 +1,223 @@
+"""ROS34PW2, a linearly implicit Rosenbrock-W method of order 3 with an embedded order-2 estimate (compiled).
+
+Rang & Angermann 2005 (BIT 45:761, Table 4.2 "ROS34PW2"): 4 stages, stiffly accurate, L-stable, order 3 with the
+exact Jacobian and order 2 with any matrix in its place (a W-method). In Hairer & Wanner II §IV.7 form (7.4) with
+Γ = (γ_ij), γ_ii = γ, and a time derivative for non-autonomous right-hand sides:
+
+    (I − hγJ) k_i = h f(t + α_i h, y + Σ_j<i α_ij k_j) + hJ Σ_j<i γ_ij k_j + γ_i h² f_t,   y₁ = y + Σ b_i k_i
+
+and computed in the transformed variables u_i = Σ_j≤i γ_ij k_j (HW II (7.4')), so that each stage is one solve with
+W = I/(hγ) − J (LU-factored once per step) and no product with J:
+
+    W u_i = f(t + α_i h, y + Σ_j<i a_ij u_j) + Σ_j<i (c_ij / h) u_j + γ_i h f_t,   y₁ = y + Σ m_i u_i,
+    a = α Γ⁻¹,  c = −Γ⁻¹ off the diagonal,  m = bᵀ Γ⁻¹,  the error estimate Σ e_i u_i with e = (b − b̂)ᵀ Γ⁻¹.
+
+J = ∂f/∂y and f_t = ∂f/∂t are forward differences of the compiled rhs (evaluate_jacobian). The continuous extension
+is the cubic Hermite interpolant of y, f(y) at both ends (local error O(h⁴), the method's order), written as the
+stage vectors of DOPRI5's dense form (dopri.interpolate), so that event location, samples and peak search read
+both methods' steps alike.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from clearsim.assembly.arrays import copy_into
+from clearsim.assembly.dynamics import WORK_COUNT, coordinate_count, rhs
+from clearsim.solver import dopri
+
+STAGES = 4
+GAMMA = 0.435866521508459
+ALPHA = np.array([  # α_ij
+    [0.0, 0.0, 0.0, 0.0],
+    [0.87173304301691801, 0.0, 0.0, 0.0],
+    [0.84457060015369423, -0.11299064236484185, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+])
+GAMMAS = np.array([  # γ_ij, γ_ii = GAMMA
+    [GAMMA, 0.0, 0.0, 0.0],
+    [-0.87173304301691801, GAMMA, 0.0, 0.0],
+    [-0.90338057013044082, 0.054180672388095326, GAMMA, 0.0],
+    [0.24212380706095346, -1.2232505839045147, 0.54526025533510214, GAMMA],
+])
+WEIGHTS = np.array([0.24212380706095346, -1.2232505839045147, 1.5452602553351020, 0.435866521508459])  # b_i
+EMBEDDED_WEIGHTS = np.array([0.37810903145819369, -0.096042292212423178, 0.5, 0.2179332607542295])  # b̂_i
+ORDER, EMBEDDED_ORDER = 3, 2
+
+_INVERSE = np.linalg.inv(GAMMAS)
+STAGE_MATRIX = ALPHA @ _INVERSE  # a_ij
+COUPLING = np.tril(-_INVERSE, -1)  # c_ij
+SOLUTION = WEIGHTS @ _INVERSE  # m_i
+ERROR = (WEIGHTS - EMBEDDED_WEIGHTS) @ _INVERSE  # e_i
+NODES = ALPHA.sum(axis=1)  # α_i
+TIME_WEIGHTS = GAMMAS.sum(axis=1)  # γ_i (with the diagonal)
+# the Hermite cubic's coefficient vectors c_p (of θ, θ², θ³, over h) → DOPRI5 stage vectors K = S c with S the first
+# three columns of P (PᵀP)⁻¹, P = dopri.DENSE (7 × 4): then h Σ_j K_j Σ_p P_jp θ^(p+1) = h Σ_p c_p θ^(p+1), no θ⁴
+HERMITE_STAGES = (dopri.DENSE @ np.linalg.inv(dopri.DENSE.T @ dopri.DENSE))[:, :3].copy()
+# J is taken anew after this many accepted steps (evaluate_jacobian; docs/model.md §4): 1, a J for each new step,
+# kept through its rejected attempts and its event refinement. Reusing it longer, as a W-method may, cost more than it
+# saved on the squeeze film (ε 0 → 0.9 in tests/validation/test_lubricated_joint.py): up to 20 steps, 4 573 steps and
+# 3 567 rejected (0.18 s); up to 3, 3 566 rejected; 1: 2 972 steps and 6 rejected (0.09 s)
+JACOBIAN_MAX_AGE = 1
+ROUNDOFF = np.sqrt(np.finfo(np.float64).eps)
+
+
+@njit(cache=True)
+def jacobian_is_stale(age, modes, jacobian_modes):
+    """J must be taken anew: none yet (age < 0), the contact modes changed since, or it has served its steps."""
+    if age < 0 or age >= JACOBIAN_MAX_AGE:
+        return True
+    for k in range(modes.shape[0]):
+        if modes[k] != jacobian_modes[k]:
+            return True
+    return False
+
+
+@njit(cache=True)
+def evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, skipped_from, skipped_count, floor, jacobian,
+                      jacobian_modes):
+    """∂f/∂y into jacobian[:, :ny] and ∂f/∂t into jacobian[:, ny] by forward differences from f = f(t, y)
+    (increments √ε max(|y_j|, floor), in time √ε max(|t|, h), at most h/2); the columns of the integrated powers
+    (skipped_from, skipped_count: f does not depend on them) are zero. Returns the rhs evaluations made."""
+    ny = y.shape[0]
+    shifted = y.copy()
+    column = np.empty(ny)
+    count = 0
+    for j in range(ny):
+        if skipped_from <= j < skipped_from + skipped_count:
+            for i in range(ny):
+                jacobian[i, j] = 0.0
+            continue
+        increment = ROUNDOFF * max(abs(y[j]), floor)
+        shifted[j] = y[j] + increment
+        increment = shifted[j] - y[j]  # the increment as represented
+        rhs(system, dynamics, t, shifted, modes, speeds, column)
+        shifted[j] = y[j]
+        for i in range(ny):
+            jacobian[i, j] = (column[i] - f[i]) / increment
+        count += 1
+    increment = min(ROUNDOFF * max(abs(t), h), 0.5 * h)
+    rhs(system, dynamics, t + increment, y, modes, speeds, column)
+    for i in range(ny):
+        jacobian[i, ny] = (column[i] - f[i]) / increment
+    copy_into(jacobian_modes, modes)
+    return count + 1
+
+
+@njit(cache=True)
+def jacobian_evaluations(y):
+    """The rhs evaluations evaluate_jacobian makes for a state like y: one per column but the integrated powers', and
+    one for ∂f/∂t."""
+    return y.shape[0] - WORK_COUNT + 1
+
+
+@njit(cache=True)
+def attempt(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian, jacobian_modes, take_jacobian, floor):
+    """One step (step) from (t, y), J and ∂f/∂t taken anew at (t, y) first when take_jacobian (evaluate_jacobian, the
+    increments' floor `floor`); returns the error vector. The loop calls it by address (integrator.addressed_kernels),
+    so that it is compiled on its own and not into the loop."""
+    if take_jacobian:
+        evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, 2 * coordinate_count(system), WORK_COUNT, floor,
+                          jacobian, jacobian_modes)
+    return step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian)[0]
+
+
+@njit(cache=True)
+def lu_factor(matrix, pivots):
+    """LU with partial pivoting in place (Doolittle; L's unit diagonal implied); pivots[i] = the row swapped with i."""
+    n = matrix.shape[0]
+    for k in range(n):
+        pivot = k
+        for i in range(k + 1, n):
+            if abs(matrix[i, k]) > abs(matrix[pivot, k]):
+                pivot = i
+        pivots[k] = pivot
+        if pivot != k:
+            for j in range(n):
+                matrix[k, j], matrix[pivot, j] = matrix[pivot, j], matrix[k, j]
+        diagonal = matrix[k, k]
+        if diagonal == 0.0:
+            continue
+        for i in range(k + 1, n):
+            factor = matrix[i, k] / diagonal
+            matrix[i, k] = factor
+            if factor != 0.0:
+                for j in range(k + 1, n):
+                    matrix[i, j] -= factor * matrix[k, j]
+
+
+@njit(cache=True)
+def lu_solve(matrix, pivots, b):
+    """Solve with lu_factor's result, b overwritten by the solution."""
+    n = matrix.shape[0]
+    for k in range(n):
+        p = pivots[k]
+        if p != k:
+            b[k], b[p] = b[p], b[k]
+    for i in range(n):
+        value = b[i]
+        for j in range(i):
+            value -= matrix[i, j] * b[j]
+        b[i] = value
+    for i in range(n - 1, -1, -1):
+        value = b[i]
+        for j in range(i + 1, n):
+            value -= matrix[i, j] * b[j]
+        b[i] = value / matrix[i, i]
+
+
+@njit(cache=True)
+def step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian):
+    """One ROS34PW2 step from (t, y) with ẏ(t) = f and J, f_t in jacobian; fills y_new and, as DOPRI5 stage vectors
+    (dopri.interpolate), the Hermite continuous extension; returns (the error vector, the rhs evaluations made)."""
+    ny = y.shape[0]
+    matrix = np.empty((ny, ny))
+    for i in range(ny):
+        for j in range(ny):
+            matrix[i, j] = -jacobian[i, j]
+        matrix[i, i] += 1.0 / (h * GAMMA)
+    pivots = np.empty(ny, np.int64)
+    lu_factor(matrix, pivots)
+    units = np.zeros((STAGES, ny))
+    work = np.empty(ny)
+    argument = np.empty(ny)
+    end = np.nextafter(t + h, t)  # as dopri.step: the step sees the piece of a prescribed motion it integrates over
+    for s in range(STAGES):
+        if s == 0:
+            copy_into(work, f)
+        else:
+            copy_into(argument, y)
+            for j in range(s):
+                for i in range(ny):
+                    argument[i] += STAGE_MATRIX[s, j] * units[j, i]
+            rhs(system, dynamics, min(t + NODES[s] * h, end), argument, modes, speeds, work)
+        for j in range(s):
+            for i in range(ny):
+                work[i] += COUPLING[s, j] / h * units[j, i]
+        for i in range(ny):
+            work[i] += TIME_WEIGHTS[s] * h * jacobian[i, ny]
+        lu_solve(matrix, pivots, work)
+        copy_into(units[s], work)
+    error = np.zeros(ny)
+    copy_into(y_new, y)
+    for s in range(STAGES):
+        for i in range(ny):
+            y_new[i] += SOLUTION[s] * units[s, i]
+            error[i] += ERROR[s] * units[s, i]
+    f_end = np.empty(ny)
+    rhs(system, dynamics, end, y_new, modes, speeds, f_end)
+    hermite_stages(y, y_new, f, f_end, h, stages)
+    return error, STAGES
+
+
+@njit(cache=True)
+def hermite_stages(y, y_new, f, f_end, h, stages):
+    """The cubic Hermite interpolant of (y, f) and (y_new, f_end) as DOPRI5 stage vectors (HERMITE_STAGES)."""
+    for i in range(y.shape[0]):
+        slope = (y_new[i] - y[i]) / h
+        c1 = f[i]
+        c2 = 3.0 * slope - 2.0 * f[i] - f_end[i]
+        c3 = f[i] + f_end[i] - 2.0 * slope
+        for j in range(stages.shape[0]):
+            stages[j, i] = HERMITE_STAGES[j, 0] * c1 + HERMITE_STAGES[j, 1] * c2 + HERMITE_STAGES[j, 2] * c3

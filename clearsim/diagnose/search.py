@@ -489,46 +489,62 @@ class LocalParabola:
 
     vertex: float  # v
     vertex_error: float  # the standard error of v (delta method)
-    curvature: float  # a > 0
+    curvature: float  # a
     scatter: float  # RMS of the runs' χ² about the parabola (the chaotic impacts' run-to-run spread), χ²
     dof: int  # runs − 3
+    span: tuple[float, float]  # of the runs it was fitted to
+
+    @property
+    def convex(self) -> bool:
+        """A minimum among its runs: a > 0 and v within their span."""
+        return self.curvature > 0.0 and self.span[0] <= self.vertex <= self.span[1]
+
+    def quantile(self, level: float = INTERVAL_LEVEL) -> float:
+        """Student's t at the two-sided `level`, for its dof (its scatter is estimated from dof residuals)."""
+        return float(student.ppf(0.5 + 0.5 * level, max(self.dof, 1)))
+
+    def indistinct(self, level: float = INTERVAL_LEVEL) -> float:
+        """Δχ² the runs' scatter leaves undecided at `level`: t·scatter."""
+        return self.quantile(level) * self.scatter
 
     def half_width(self, threshold: float, level: float = INTERVAL_LEVEL) -> float:
-        """The interval's half-width about v: the parabola's rise to `threshold` plus its rise to t·scatter (values
-        the runs' scatter does not tell apart), with t·σ_v for the vertex's own uncertainty (t: Student's, dof)."""
-        t = float(student.ppf(0.5 + 0.5 * level, max(self.dof, 1)))
+        """A convex parabola's interval half-width about v: its rise to `threshold` plus the scatter's t·s (values the
+        runs do not tell apart), with t·σ_v for the vertex's own uncertainty."""
+        t = self.quantile(level)
         return float(np.sqrt((t * self.vertex_error) ** 2 + (threshold + t * self.scatter) / self.curvature))
 
 
 def local_parabola(units: np.ndarray, chi: np.ndarray) -> LocalParabola | None:
-    """The parabola through the PROFILE_POINTS runs nearest the lowest one; None when too few runs to estimate its
-    scatter, or when it is not convex or its vertex leaves their span."""
+    """The parabola through the PROFILE_POINTS runs nearest the lowest one; None when fewer than 5 runs (its scatter
+    needs 2 residual degrees of freedom) or they share one value."""
     near = np.argsort(np.abs(units - units[np.argmin(chi)]))[:PROFILE_POINTS]
     if len(near) < 5 or np.ptp(units[near]) <= 0.0:
         return None
     centre = float(units[np.argmin(chi)])
     coefficients, covariance = np.polyfit(units[near] - centre, chi[near], 2, cov="unscaled")
     a, b, _ = coefficients
-    if a <= 0.0 or not units[near].min() <= centre - b / (2.0 * a) <= units[near].max():
-        return None
     dof = len(near) - 3
     scatter = float(np.sqrt(np.sum((chi[near] - np.polyval(coefficients, units[near] - centre)) ** 2) / dof))
+    if a == 0.0:
+        return LocalParabola(centre, np.inf, 0.0, scatter, dof, (float(units[near].min()), float(units[near].max())))
     gradient = np.array([b / (2.0 * a * a), -1.0 / (2.0 * a), 0.0])
     error = float(scatter * np.sqrt(max(gradient @ covariance @ gradient, 0.0)))
-    return LocalParabola(centre - b / (2.0 * a), error, float(a), scatter, dof)
+    return LocalParabola(centre - b / (2.0 * a), error, float(a), scatter, dof,
+                         (float(units[near].min()), float(units[near].max())))
 
 
 def interval(scored: Scored, record: Record) -> tuple[float, float]:
     """The profile interval at INTERVAL_LEVEL (docs/diagnose.md §4 step 4): the evaluated values whose χ² is within
-    Δ = scored.allowance (profile_threshold) of the best, widened halfway to the next evaluated values outside, joined
-    with the local parabola's vertex ± its half-width (LocalParabola.half_width: the runs' scatter and the vertex's
-    uncertainty, which the evaluated grid alone does not show)."""
+    Δ = scored.allowance (profile_threshold) plus the runs' scatter t·s (LocalParabola.indistinct) of the best, widened
+    halfway to the next evaluated values outside, joined with a convex local parabola's vertex ± its half-width
+    (LocalParabola.half_width: the scatter and the vertex's uncertainty, which the evaluated grid alone does not show)."""
     finished = sorted((p for p in scored.points if p.fit is not None), key=lambda p: p.value)
     units = scored.candidate.to_unit([p.value for p in finished])
     chi = np.array([p.chi_square for p in finished])
-    low_u, high_u = grid_interval(units, chi, scored.allowance)
     parabola = local_parabola(units, chi) if np.all(np.isfinite(chi)) else None
-    if parabola is not None:
+    spread = parabola.indistinct() if parabola is not None else 0.0
+    low_u, high_u = grid_interval(units, chi, scored.allowance + spread)
+    if parabola is not None and parabola.convex:
         half = parabola.half_width(scored.allowance)
         low_u, high_u = min(low_u, parabola.vertex - half), max(high_u, parabola.vertex + half)
     low_u, high_u = np.clip([low_u, high_u], 0.0, 1.0)

@@ -516,9 +516,9 @@ class LocalParabola:
 
 def local_parabola(units: np.ndarray, chi: np.ndarray) -> LocalParabola | None:
     """The parabola through the PROFILE_POINTS runs nearest the lowest one; None when fewer than 5 runs (its scatter
-    needs 2 residual degrees of freedom) or they share one value."""
+    needs 2 residual degrees of freedom) or fewer than 3 distinct values among them (a screened candidate's runs)."""
     near = np.argsort(np.abs(units - units[np.argmin(chi)]))[:PROFILE_POINTS]
-    if len(near) < 5 or np.ptp(units[near]) <= 0.0:
+    if len(near) < 5 or len(np.unique(units[near])) < 3:
         return None
     centre = float(units[np.argmin(chi)])
     coefficients, covariance = np.polyfit(units[near] - centre, chi[near], 2, cov="unscaled")

@@ -233,12 +233,13 @@ def score(case: Case, found: dict, wall: float) -> dict:
 
 
 def rescored(case: Case, root: Path, row: dict) -> dict:
-    """The case scored again from its report (after a change of the scoring), with the wall time it was run in."""
+    """The case scored again from its report (after a change of the scoring, or diagnosed again on its kept runs), with
+    the wall time and simulations of its first diagnosis."""
     if "error" in row:
         return row
     found = json.loads((root / case.name / "report" / "diagnosis.json").read_text())
     _, placement = truth_document(case, model_file(case, root / case.name))
-    return score(case, found, row["wall_s"]) | placement
+    return score(case, found, row["wall_s"]) | placement | {"simulations": row["simulations"]}
 
 
 def done_cases(path: Path) -> dict[str, dict]:

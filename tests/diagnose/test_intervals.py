@@ -68,3 +68,14 @@ def test_the_interval_covers_the_minimum_of_a_scattered_profile_at_its_stated_ra
         low, high = interval(scored, record)
         covered.append(low <= truth <= high)
     assert np.mean(covered) >= 0.9
+
+
+def test_a_profile_of_few_distinct_values_has_the_interval_of_its_runs():
+    """Runs at two values only (a candidate screened, its runs repeated by an ensemble): no parabola to fit (its normal
+    equations are singular), the interval is the runs' own."""
+    candidate = Candidate("mass", "pole", "mass factor", "", 0.0, 1.0, False, 1.0, lambda document, value: None)
+    scored = Scored(candidate, [Point(u, SimpleNamespace(chi_square=c), None)
+                                for u, c in [(0.3, 50.0), (0.3, 50.0), (0.3, 50.0), (0.75, 90.0), (0.75, 90.0)]])
+    scored.allowance = 4.0
+    record = SimpleNamespace(noise={}, effective_samples=40.0)
+    assert interval(scored, record) == pytest.approx((0.0, 0.525))

@@ -43,7 +43,11 @@ from typing import Callable
 
 import numpy as np
 
-from clearsim.diagnose.align import Fit, Record, chi_square_halves, fit_at, fit_offset, predict, residuals
+from scipy.stats import chi2, norm
+from scipy.stats import f as fisher
+from scipy.stats import t as student
+
+from clearsim.diagnose.align import INTERVAL_LEVEL, Fit, Record, chi_square_halves, fit_at, fit_offset, predict, residuals
 from clearsim.diagnose.candidates import Candidate, with_effects
 from clearsim.diagnose.evaluate import Evaluator, Prediction
 from clearsim.diagnose.features import dominant_frequency
@@ -462,7 +466,7 @@ def judge(scored: list[Scored], baseline: Fit, record: Record) -> list[Scored]:
     for s in scored:
         if s.best is None:
             continue
-        s.allowance = max(1.0, s.best.chi_square / max(record.effective_samples, 1.0))
+        s.allowance = profile_threshold(s.best.chi_square, record)
         s.bic = s.best.chi_square + penalty  # the evidence: the best any run did (a rough candidate's estimate is its smoothed minimum)
         s.delta_bic = s.bic - baseline.chi_square
         s.interval = interval(s, record) if s.smoothed is None else smoothed_interval(s)
@@ -470,27 +474,99 @@ def judge(scored: list[Scored], baseline: Fit, record: Record) -> list[Scored]:
     return ranked
 
 
+def profile_threshold(chi_square_min: float, record: Record, level: float = INTERVAL_LEVEL) -> float:
+    """Δχ² of the profile interval at `level` (D7): the F(1, ν) quantile — χ²₁'s when σ̂ is exact, wider by σ̂'s own
+    uncertainty (ν: the smallest of the sensors' noise degrees of freedom) — times the Birge ratio χ²_min/n_eff when
+    the best model still misses the record by more than the noise."""
+    dof = min((n.degrees_of_freedom for n in record.noise.values()), default=np.inf)
+    quantile = chi2.ppf(level, 1) if not np.isfinite(dof) else fisher.ppf(level, 1, dof)
+    return float(quantile * max(1.0, chi_square_min / max(record.effective_samples, 1.0)))
+
+
+@dataclass(frozen=True)
+class LocalParabola:
+    """χ² ≈ a (u − v)² + c fitted (least squares) to the runs nearest a profile's lowest one, in the unit range."""
+
+    vertex: float  # v
+    vertex_error: float  # the standard error of v (delta method)
+    curvature: float  # a
+    scatter: float  # RMS of the runs' χ² about the parabola (the chaotic impacts' run-to-run spread), χ²
+    dof: int  # runs − 3
+    span: tuple[float, float]  # of the runs it was fitted to
+
+    @property
+    def convex(self) -> bool:
+        """A minimum among its runs: a > 0 and v within their span."""
+        return self.curvature > 0.0 and self.span[0] <= self.vertex <= self.span[1]
+
+    def quantile(self, level: float = INTERVAL_LEVEL) -> float:
+        """Student's t at the two-sided `level`, for its dof (its scatter is estimated from dof residuals)."""
+        return float(student.ppf(0.5 + 0.5 * level, max(self.dof, 1)))
+
+    def indistinct(self, level: float = INTERVAL_LEVEL) -> float:
+        """Δχ² the runs' scatter leaves undecided at `level`: t·scatter."""
+        return self.quantile(level) * self.scatter
+
+    def half_width(self, threshold: float, level: float = INTERVAL_LEVEL) -> float:
+        """A convex parabola's interval half-width about v: its rise to `threshold` plus the scatter's t·s (values the
+        runs do not tell apart), with t·σ_v for the vertex's own uncertainty."""
+        t = self.quantile(level)
+        return float(np.sqrt((t * self.vertex_error) ** 2 + (threshold + t * self.scatter) / self.curvature))
+
+
+def local_parabola(units: np.ndarray, chi: np.ndarray) -> LocalParabola | None:
+    """The parabola through the PROFILE_POINTS runs nearest the lowest one; None when fewer than 5 runs (its scatter
+    needs 2 residual degrees of freedom) or fewer than 3 distinct values among them (a screened candidate's runs)."""
+    near = np.argsort(np.abs(units - units[np.argmin(chi)]))[:PROFILE_POINTS]
+    if len(near) < 5 or len(np.unique(units[near])) < 3:
+        return None
+    centre = float(units[np.argmin(chi)])
+    coefficients, covariance = np.polyfit(units[near] - centre, chi[near], 2, cov="unscaled")
+    a, b, _ = coefficients
+    dof = len(near) - 3
+    scatter = float(np.sqrt(np.sum((chi[near] - np.polyval(coefficients, units[near] - centre)) ** 2) / dof))
+    if a == 0.0:
+        return LocalParabola(centre, np.inf, 0.0, scatter, dof, (float(units[near].min()), float(units[near].max())))
+    gradient = np.array([b / (2.0 * a * a), -1.0 / (2.0 * a), 0.0])
+    error = float(scatter * np.sqrt(max(gradient @ covariance @ gradient, 0.0)))
+    return LocalParabola(centre - b / (2.0 * a), error, float(a), scatter, dof,
+                         (float(units[near].min()), float(units[near].max())))
+
+
 def interval(scored: Scored, record: Record) -> tuple[float, float]:
-    """Values whose χ² is within Δ = max(1, χ²_min/n_eff) of the best, widened halfway to the next
-    evaluated values outside (a profile interval on the evaluated grid; ~68 % for smooth costs)."""
+    """The profile interval at INTERVAL_LEVEL (docs/diagnose.md §4 step 4): the evaluated values whose χ² is within
+    Δ = scored.allowance (profile_threshold) plus the runs' scatter t·s (LocalParabola.indistinct) of the best, widened
+    halfway to the next evaluated values outside, joined with a convex local parabola's vertex ± its half-width
+    (LocalParabola.half_width: the scatter and the vertex's uncertainty, which the evaluated grid alone does not show)."""
     finished = sorted((p for p in scored.points if p.fit is not None), key=lambda p: p.value)
-    values = np.array([p.value for p in finished])
+    units = scored.candidate.to_unit([p.value for p in finished])
     chi = np.array([p.chi_square for p in finished])
-    best = float(chi.min())
-    allowance = scored.allowance
-    inside = np.nonzero(chi <= best + allowance)[0]
-    lo, hi = inside.min(), inside.max()
-    units = scored.candidate.to_unit(values)
-    low_u = 0.5 * (units[lo] + units[lo - 1]) if lo > 0 else 0.0
-    high_u = 0.5 * (units[hi] + units[hi + 1]) if hi + 1 < len(units) else 1.0
+    parabola = local_parabola(units, chi) if np.all(np.isfinite(chi)) else None
+    spread = parabola.indistinct() if parabola is not None else 0.0
+    low_u, high_u = grid_interval(units, chi, scored.allowance + spread)
+    if parabola is not None and parabola.convex:
+        half = parabola.half_width(scored.allowance)
+        low_u, high_u = min(low_u, parabola.vertex - half), max(high_u, parabola.vertex + half)
+    low_u, high_u = np.clip([low_u, high_u], 0.0, 1.0)
     return float(scored.candidate.from_unit(low_u)), float(scored.candidate.from_unit(high_u))
 
 
+def grid_interval(units: np.ndarray, chi: np.ndarray, allowance: float) -> tuple[float, float]:
+    """The span (unit range, runs sorted by value) of the runs within `allowance` of the lowest χ², widened halfway to
+    the next runs outside (to the bounds where there is none)."""
+    inside = np.nonzero(chi <= chi.min() + allowance)[0]
+    lo, hi = inside.min(), inside.max()
+    low_u = 0.5 * (units[lo] + units[lo - 1]) if lo > 0 else 0.0
+    high_u = 0.5 * (units[hi] + units[hi + 1]) if hi + 1 < len(units) else 1.0
+    return float(low_u), float(high_u)
+
+
 def smoothed_interval(scored: Scored, profile: tuple[float, float] | None = None) -> tuple[float, float]:
-    """A rough candidate's interval: the smoothed profile's vertex ± its uncertainty (of the band chosen, or of
-    `profile`: one band's (vertex, error)), within the bounds."""
+    """A rough candidate's interval at INTERVAL_LEVEL: the smoothed profile's vertex ± the normal quantile times its
+    uncertainty (of the band chosen, or of `profile`: one band's (vertex, error)), within the bounds."""
     vertex, error = profile or scored.smoothed
-    low, high = np.clip([vertex - error, vertex + error], 0.0, 1.0)
+    half = float(norm.ppf(0.5 + 0.5 * INTERVAL_LEVEL)) * error
+    low, high = np.clip([vertex - half, vertex + half], 0.0, 1.0)
     return float(scored.candidate.from_unit(low)), float(scored.candidate.from_unit(high))
 
 

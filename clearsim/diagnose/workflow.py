@@ -27,7 +27,7 @@ from clearsim.diagnose.features import Feature, Window, disagreement_windows, fe
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
 from clearsim.diagnose.search import (AS_GIVEN, PERTURBATIONS, SIGNIFICANCE, Ensembled, JointFit, Point, Scored, SearchProgress,
                                      Tracked, aligned_residuals, halves_improved, judge, low_band_best, mark_ties,
-                                     refine, refit_jointly, robust_to_perturbations, score_point, screen,
+                                     profile_threshold, refine, refit_jointly, robust_to_perturbations, score_point, screen,
                                      seen_by_sensors, setting, significant_on_both_halves, to_fit)
 from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.model.loader import load_mechanism, load_mechanism_text
@@ -343,7 +343,7 @@ def refitted(evaluator, record: Record, sensors: list[str], document: dict, effe
     failed = next((p for p in points if p.fit is None), None)
     if failed is not None:
         raise DiagnoseError(f"the model with the refitted effects {failed.value} does not run: {failed.error}")
-    allowance = max(1.0, joint.best.chi_square / max(record.effective_samples, 1.0))
+    allowance = profile_threshold(joint.best.chi_square, record)
     befores = [effects[0].before] + [p.fit for p in points[:-1]]
     return [Effect(e.scored, v, i, p, b)
             for e, v, i, p, b in zip(effects, values, joint.intervals(allowance), points, befores)]

@@ -405,6 +405,60 @@ def synthesize(
                   f"over {record.time[-1] * 1e3:.3f} ms", highlight=False, soft_wrap=True)
 
 
+def _life_progress(total: int):
+    """(bar, heartbeat, update(done, total, blocks)): operations done of the life's target, blocks kept."""
+    progress = Progress(TextColumn("wearing"), BarColumn(), MofNCompleteColumn(), TextColumn("operations"),
+                        TextColumn("{task.fields[blocks]} blocks"), TimeElapsedColumn(), console=errors,
+                        transient=True, disable=not errors.is_terminal)
+    task = progress.add_task("life", total=total, blocks=0)
+    beat = heartbeat("life")
+
+    def update(done: int, target: int, blocks: int) -> None:
+        progress.update(task, completed=done, total=target, blocks=blocks)
+        beat.update(f"{done} of {target} operations, {blocks} blocks", done, target)
+
+    return progress, beat, update
+
+
+@app.command()
+@user_errors
+def life(
+    config: Optional[Path] = ConfigArgument,
+    operations: int = typer.Option(..., "--operations", "-n", help="Operations of the life, e.g. 10000."),
+    output: Path = typer.Option(Path("results/life.h5"), "-o", "--output", help="Life file (HDF5)."),
+    tolerance: float = typer.Option(0.02, "--tolerance", help="Error allowed per block, a fraction of each wearing joint's clearance."),
+    overrides: List[str] = SetOption,
+) -> None:
+    """Wear over a service life: simulate an operation, accumulate its wear, scale it over a block, update the bores, repeat."""
+    from clearsim.life.run import LifeRequest, run_life
+
+    _announce_compile()
+    progress, beat, update = _life_progress(operations)
+    with progress, beat:
+        report = run_life(LifeRequest(config or _bundled(), operations, output, tolerance, overrides), update)
+    if report.backup is not None:
+        console.print(f"kept the earlier life as {report.backup}")
+    started = "continued from" if report.resumed_from is not None else "new machine,"
+    console.print(f"[bold]life[/]: {report.status} → {report.output}: {report.last.operations} operations "
+                  f"({started} {report.resumed_from or 0}), {report.blocks} blocks, {report.simulations} operations simulated")
+    console.print(_life_table(report.output))
+
+
+def _bundled() -> Path:
+    from clearsim.runner import BUNDLED_CONFIG
+
+    return BUNDLED_CONFIG
+
+
+def _life_table(path: Path) -> Table:
+    from clearsim.life.store import life_rows
+
+    table = Table(show_header=False, box=None, pad_edge=False)
+    for label, value in life_rows(path):
+        table.add_row(label, value)
+    return table
+
+
 def _diagnosis_progress():
     """(live line, heartbeat, update(SearchProgress)): runs done of those planned so far, the best gap and its model,
     the time elapsed; on stdout with the diagnosis's own lines (in a terminal), else a heartbeat on stderr."""

@@ -96,9 +96,12 @@ def advanced(state: dict[str, np.ndarray], rates: list[Operation], weights: list
 
 def live(simulate: Callable[[dict[str, np.ndarray]], Operation], start: Block, operations: int,
          clearances: dict[str, float], control: BlockControl, size: int | None = None,
-         kept: Callable[[Block, int], None] = lambda block, next_size: None) -> Block:
+         kept: Callable[[Block, int], None] = lambda block, next_size: None,
+         simulate_end: Callable[[dict[str, np.ndarray], int], Operation] | None = None) -> Block:
     """Blocks from `start` (operations done, state, the operation simulated at it) until `operations` are done;
-    `kept(block, next size)` after each kept block (the life file's row, resumable from it). → the last block."""
+    `kept(block, next size)` after each kept block (the life file's row, resumable from it); the operation at a kept
+    block's end is simulate_end(state, operations done) (default: simulate). → the last block."""
+    simulate_end = simulate_end or (lambda state, done: simulate(state))
     allowances = {joint: control.tolerance * clearance for joint, clearance in clearances.items()}
     block = start
     size = size or first_size(block.operation, allowances)
@@ -112,7 +115,7 @@ def live(simulate: Callable[[dict[str, np.ndarray]], Operation], start: Block, o
             size = next_size(size, ratio, control)
             continue
         state = advanced(block.state, [block.operation, predicted], [0.5, 0.5], size)
-        block = Block(block.operations + size, size, state, simulate(state), ratio, refused)
+        block = Block(block.operations + size, size, state, simulate_end(state, block.operations + size), ratio, refused)
         refused = 0
         size = next_size(size, ratio, control)
         kept(block, size)

@@ -23,7 +23,9 @@ from pathlib import Path
 from clearsim.plot import history, journal, measured as measured_plots, sweep, travel
 from clearsim.plot.animate import animate_run, check_animation, parse_exaggerate
 from clearsim.plot.data import PlotInputError, RunData, apply_window, load_run, parse_time_window, signals
+from clearsim.life.store import is_life_file
 from clearsim.plot.labels import run_labels
+from clearsim.plot.life import life_figures
 from clearsim.plot.style import DPI, FORMATS, show_all
 
 
@@ -176,12 +178,28 @@ def _save(figures: dict, folder: Path, stem: str, fmt: str) -> list[Path]:
     return written
 
 
+def _plot_lives(lives: list[Path], request: PlotRequest) -> PlotReport:
+    """The pages of life files (clearsim.plot.life), each in its own folder or --out."""
+    if len(lives) != len(request.inputs):
+        raise PlotInputError("a life file is plotted alone (its wear, clearance and drift pages): give life files "
+                             "only, or result files only")
+    written = []
+    for path in lives:
+        folder = Path(request.out) if request.out is not None else path.parent
+        written += _save(life_figures(path, request.show), folder, path.stem, request.fmt)
+    notes = [note] if request.show and (note := show_all()) else []
+    return PlotReport(written, notes)
+
+
 def plot_results(request: PlotRequest) -> PlotReport:
     """Read the inputs, build every figure, then write them (and the animations); paths and notes."""
     if request.fmt not in FORMATS:
         raise PlotInputError(f"--format {request.fmt!r}: expected one of {', '.join(FORMATS)}")
     if request.out is not None and Path(request.out).exists() and not Path(request.out).is_dir():
         raise PlotInputError(f"--out {request.out}: is a file, not a folder; give the folder for the figures")
+    lives = [Path(path) for path in request.inputs if Path(path).is_file() and is_life_file(Path(path))]
+    if lives:
+        return _plot_lives(lives, request)
     skipped: list = []
     groups = _inputs(request.inputs, skipped)
     loaded = [(inputs, runs) for inputs in groups if (runs := _load(inputs, request, skipped))]

@@ -12,7 +12,9 @@ block's error (Hairer, Nørsett & Wanner, Solving ODEs I, §II.4: embedded pair 
 when that error is at most `tolerance` × the joint's clearance for every joint; the next block's size is
 N · min(growth, max(shrink, safety · (1/ratio)^(1/2))) with ratio the error over its allowance. A kept block costs two
 operations simulated: r(H*) and r(H') (the latter is the next block's start, and the operation whose figures are
-recorded for the block); a refused one costs one. A rate that does not change with the profile gives zero error: the
+recorded for the block); a refused one costs one. A block whose predicted or corrected bores cannot be simulated
+(OperationFailed: the solver could not continue) is refused too, and shrunk by `shrink`; at one operation the failure
+stops the life. A rate that does not change with the profile gives zero error: the
 blocks then grow by `growth` each time, and the result is exact.
 """
 
@@ -25,6 +27,10 @@ from typing import Callable
 import numpy as np
 
 PROFILE_ANGLES = 720  # the depth norm's grid: every 0.5°
+
+
+class OperationFailed(Exception):
+    """An operation that could not be simulated with the bores worn to a state (the solver could not continue)."""
 
 
 @dataclass(frozen=True)
@@ -108,14 +114,22 @@ def live(simulate: Callable[[dict[str, np.ndarray]], Operation], start: Block, o
     refused = 0
     while block.operations < operations:
         size = min(size, operations - block.operations)
-        predicted = simulate(advanced(block.state, [block.operation], [1.0], size))
-        ratio = error_ratio(block.operation, predicted, size, allowances)
-        if ratio > 1.0 and size > 1:
+        try:
+            predicted = simulate(advanced(block.state, [block.operation], [1.0], size))
+            ratio = error_ratio(block.operation, predicted, size, allowances)
+            if ratio > 1.0 and size > 1:
+                refused += 1
+                size = next_size(size, ratio, control)
+                continue
+            state = advanced(block.state, [block.operation, predicted], [0.5, 0.5], size)
+            end = simulate_end(state, block.operations + size)
+        except OperationFailed:
+            if size == 1:
+                raise
             refused += 1
-            size = next_size(size, ratio, control)
+            size = max(1, int(size * control.shrink))
             continue
-        state = advanced(block.state, [block.operation, predicted], [0.5, 0.5], size)
-        block = Block(block.operations + size, size, state, simulate_end(state, block.operations + size), ratio, refused)
+        block = Block(block.operations + size, size, state, end, ratio, refused)
         refused = 0
         size = next_size(size, ratio, control)
         kept(block, size)

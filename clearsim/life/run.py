@@ -14,7 +14,7 @@ import numpy as np
 
 from clearsim.errors import ClearsimError, Problem, InputError
 from clearsim.io.files import keep_as_previous
-from clearsim.life.blocks import Block, BlockControl, Operation, live, profile_depth
+from clearsim.life.blocks import Block, BlockControl, Operation, OperationFailed, live, profile_depth
 from clearsim.life.store import ANGLES, LifeFile, is_life_file
 from clearsim.model.loader import LoadedMechanism, dump_yaml, load_mechanism, load_mechanism_text
 from clearsim.model.resolve import resolve_clearance
@@ -25,6 +25,10 @@ MAX_OPERATIONS = 10_000_000
 
 class LifeError(ClearsimError):
     """A life that cannot start or go on (no wearing joint, N = 0, an operation that cannot be simulated)."""
+
+
+class WornOperationFailed(LifeError, OperationFailed):
+    """An operation that the solver could not finish with the bores worn to a state: its block is refused."""
 
 
 @dataclass
@@ -112,7 +116,7 @@ class Machine:
         loaded = self.worn(state)
         report = run_to_file(prepare(loaded), loaded, output, contents="summary")
         if not report.complete:
-            raise LifeError(f"{self.loaded.path}: the operation with the bores worn to "
+            raise WornOperationFailed(f"{self.loaded.path}: the operation with the bores worn to "
                             f"{', '.join(f'{j} {max_depth(s) * 1e3:.4g} mm' for j, s in state.items())} did not "
                             f"complete: {report.status} (its file: {report.output})\n  hint: the wear may have "
                             "opened a clearance the solver settings cannot follow; see the run's message above, or "

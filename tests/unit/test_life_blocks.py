@@ -105,3 +105,21 @@ def test_a_life_resumed_from_a_kept_block_is_the_same_life():
     resumed = live(simulate, block, OPERATIONS, {"J": CLEARANCE}, BlockControl(), size=size)
     assert resumed.operations == whole.operations
     assert np.array_equal(resumed.state["J"], whole.state["J"])
+
+
+def test_a_block_whose_worn_bores_cannot_be_simulated_is_refused_and_shrunk():
+    """Beyond 0.5 c of wear the operation fails (OperationFailed): blocks that would cross it are refused; at one
+    operation the failure ends the life."""
+    from clearsim.life.blocks import OperationFailed
+
+    def simulate(state):
+        if state["J"][0] > 0.5 * CLEARANCE:
+            raise OperationFailed("the solver could not continue")
+        return Operation({"J": np.array([1e-8, 0.0, 0.0])})
+
+    blocks = []
+    with pytest.raises(OperationFailed):
+        live(simulate, start_of(simulate, 1), OPERATIONS, {"J": CLEARANCE}, BlockControl(),
+             kept=lambda block, size: blocks.append(block))
+    assert blocks[-1].state["J"][0] <= 0.5 * CLEARANCE < blocks[-1].state["J"][0] + 1e-8  # one operation short
+    assert sum(block.refused for block in blocks) >= 1

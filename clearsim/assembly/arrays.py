@@ -77,14 +77,15 @@ SystemArrays = namedtuple(
         "driveline_kinds", "driveline_bodies", "driveline_params", "driveline_table",  # assembly/drivelines.py
         "torsion_bodies", "torsion_params",
         "hydraulic_bodies", "hydraulic_params", "hydraulic_laws",
-        "wear_harmonics", "wear_profile", "wear_slots", "wear_rates",  # worn bores and Archard wear (physics/wear.py)
+        "wear_harmonics", "wear_profile", "wear_depth_range", "wear_slots", "wear_rates",  # worn bores, Archard wear (physics/wear.py)
     ],
     # force elements with states (assembly/hydraulics.py) and wear: none unless given
     defaults=(np.zeros((0, 2), np.int64), np.zeros((0, HYDRAULIC_COLUMNS)), np.zeros((0, HYDRAULIC_LAW_COLUMNS), np.int64),
-              np.zeros(0, np.int64), np.zeros((0, 1)), np.zeros((0, 2), np.int64), np.zeros((0, 2))),
+              np.zeros(0, np.int64), np.zeros((0, 1)), np.zeros(0), np.zeros((0, 2), np.int64), np.zeros((0, 2))),
 )
 # wear_harmonics[k]: M of joint k's worn profile (0: a circular bore), whose coefficients [a_0, a_1, b_1, ...] are the
-# start of the row wear_profile[k]. wear_slots[k]: (first slot in z of its accumulated Archard profile, −1: none;
+# start of the row wear_profile[k]; wear_depth_range[k] bounds its max − min (m; the nearest-point search's window).
+# wear_slots[k]: (first slot in z of its accumulated Archard profile, −1: none;
 # its harmonics M); wear_rates[k]: (WEAR_SCALE, g_0 .. g_M the kernel's weights)
 WEAR_SLOT, WEAR_SLOT_HARMONICS = 0, 1
 WEAR_SCALE = 0  # k_w / (H L R_B c): the rate of the scaled profile h/c per unit F_n |v_t| (1/(N·m))

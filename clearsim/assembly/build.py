@@ -310,7 +310,8 @@ def wear_arrays(parameters: list[ClearanceParameters], first_slot: int) -> dict:
                                                             * p.clearance)
             rates[k, 1:p.archard.harmonics + 2] = wear.kernel_weights(p.archard.sigma, p.archard.harmonics)
     return {"wear_harmonics": np.array([(len(p.wear_profile) - 1) // 2 for p in parameters], np.int64).reshape(count),
-            "wear_profile": profile, "wear_slots": slots, "wear_rates": rates}
+            "wear_profile": profile, "wear_depth_range": np.array([wear.depth_range(p.wear_profile) for p in parameters]),
+            "wear_slots": slots, "wear_rates": rates}
 
 
 def archard_state_count(archard) -> int:

@@ -84,7 +84,8 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
     c, s = np.cos(angle), np.sin(angle)
     local_x, local_y = c * ex + s * ey, -s * ex + c * ey
     _, rx, ry, tangent_x, tangent_y, curvature = closest_bore_point(
-        system.wear_profile[k], system.wear_harmonics[k], p[CL_BEARING_RADIUS], local_x, local_y)
+        system.wear_profile[k], system.wear_harmonics[k], system.wear_depth_range[k], p[CL_BEARING_RADIUS], local_x,
+        local_y)
     gap_x, gap_y = rx - local_x, ry - local_y
     distance = np.sqrt(gap_x * gap_x + gap_y * gap_y)
     local_nx, local_ny = gap_x / distance, gap_y / distance

@@ -23,7 +23,8 @@ import numpy as np
 from numba import njit
 from scipy.optimize import brentq
 
-NEWTON_ITERATIONS = 12  # the closest bore point converges quadratically; a step below 1e-15 rad ends it earlier
+SAFEGUARDED_ITERATIONS = 60  # Newton converges quadratically (a step below 1e-15 rad ends it); a bisection step, taken
+# when Newton would leave its bracket of 2π/(8M) either side, halves it
 SMALLEST_SIGMA = 4.0  # σ ≥ 4/M: the truncated kernel's last weight is e^{-8} = 3e-4 of the first (no ringing)
 
 
@@ -42,19 +43,78 @@ def profile_value(coefficients, harmonics, theta):
     return h, slope, curvature
 
 
+def depth_range(coefficients) -> float:
+    """An upper bound of max h − min h of a profile [a_0, a_1, b_1, …] (m): the range on 64 M angles, widened by the
+    most the series can move between two of them (Σ m √(a_m² + b_m²) times half their spacing, at each end)."""
+    coefficients = np.asarray(coefficients, float)
+    harmonics = (len(coefficients) - 1) // 2
+    if harmonics <= 0:  # a circular bore (no profile, or its mean depth alone)
+        return 0.0
+    angles = np.linspace(0.0, 2.0 * math.pi, 64 * harmonics, endpoint=False)
+    depth = evaluate_profile(coefficients, angles)
+    orders = np.arange(1, harmonics + 1)
+    slope_bound = float(np.sum(orders * np.hypot(coefficients[1::2][:harmonics], coefficients[2::2][:harmonics])))
+    return float(depth.max() - depth.min()) + slope_bound * (angles[1] - angles[0])
+
+
 @njit(cache=True)
-def closest_bore_point(coefficients, harmonics, bearing_radius, ex, ey):
+def search_window(eccentricity, depth_range):
+    """Half-width Δ (rad) round the angle θ_e of e outside which no bore point is nearer to e than the one on e's ray:
+    |r(θ) − e| ≥ ρ(θ) − |e| cos φ (φ = θ − θ_e) and |r(θ_e) − e| = ρ(θ_e) − |e|, so a nearer point needs
+    |e| (1 − cos φ) < ρ(θ_e) − ρ(θ) ≤ depth_range."""
+    if depth_range <= 0.0:
+        return 0.0
+    if depth_range >= 2.0 * eccentricity:
+        return math.pi
+    return math.acos(1.0 - depth_range / eccentricity)
+
+
+@njit(cache=True)
+def _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, theta):
+    h, _, _ = profile_value(coefficients, harmonics, theta)
+    rho = bearing_radius + h
+    return (rho * math.cos(theta) - ex) ** 2 + (rho * math.sin(theta) - ey) ** 2
+
+
+@njit(cache=True)
+def closest_bore_point(coefficients, harmonics, depth_range, bearing_radius, ex, ey):
     """(θ*, r_x, r_y, r'_x, r'_y, g') of the bore point r(θ*) closest to e = (ex, ey), all in the bearing frame;
-    g' = |r'|² + (r − e)·r'' > 0 is the curvature of |r(θ) − e|²/2 at the minimum (for the rate of θ*)."""
-    theta = np.arctan2(ey, ex) if ex * ex + ey * ey > 0.0 else 0.0
-    for _ in range(NEWTON_ITERATIONS):
+    g' = |r'|² + (r − e)·r'' is the curvature of |r(θ) − e|²/2 there (> 0 at a minimum; for the rate of θ*).
+
+    The global minimum: a bore worn tighter than the journal's curvature somewhere has several local minima of the
+    distance (a two-point contact) with a maximum between them, and Newton's method from the angle of e may stop on
+    either. Samples every 2π/(8M) over the window of search_window (none for a profile without range) pick the
+    nearest; Newton's method on g = (r − e)·r' = 0 refines it inside a bracket of one sample spacing either side,
+    a step that would leave the bracket, or a point where g' ≤ 0, taking a bisection step of the bracket instead
+    (g' ≤ 0 everywhere near e: e far from the wall, near a centre of curvature, in free flight — the bracket's
+    bisection then stops on its sampled nearest point's neighbourhood)."""
+    eccentricity = math.sqrt(ex * ex + ey * ey)
+    theta = math.atan2(ey, ex) if eccentricity > 0.0 else 0.0
+    window = search_window(eccentricity, depth_range)
+    spacing = 2.0 * math.pi / (8.0 * max(harmonics, 1))
+    if window > 0.0:
+        samples = int(math.ceil(window / spacing))
+        best, nearest = theta, _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, theta)
+        for i in range(-samples, samples + 1):
+            candidate = theta + i * spacing
+            distance = _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, candidate)
+            if distance < nearest:
+                best, nearest = candidate, distance
+        theta = best
+    low, high = theta - spacing, theta + spacing
+    for _ in range(SAFEGUARDED_ITERATIONS):
         rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
-        if second <= 0.0:  # e far from the wall, near a centre of curvature (in free flight): keep θ
+        if gradient > 0.0:
+            high = min(high, theta)
+        elif gradient < 0.0:
+            low = max(low, theta)
+        following = theta - gradient / second if second > 0.0 else low - 1.0
+        if not low <= following <= high:
+            following = 0.5 * (low + high)
+        if abs(following - theta) < 1e-15:
+            theta = following
             break
-        step = gradient / second
-        theta -= step
-        if abs(step) < 1e-15:
-            break
+        theta = following
     rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
     return theta, rx, ry, tx, ty, second
 

@@ -173,3 +173,34 @@ def test_a_centred_journal_has_finite_kinematics(system):
     kinematics = clearance_kinematics(system, 0, np.zeros(6), np.array([0.0, 0.0, 1.0, 1e-3, -1e-3, 2.0]))
     assert np.all(np.isfinite(kinematics)) and kinematics[4] < -CLEARANCE
     assert np.all(np.isfinite(stick_row(system, 0, np.zeros(6), np.ones(6))[2]))
+
+
+def test_a_pocket_tighter_than_the_journal_touches_it_at_its_rims():
+    """A 10 µm pocket worn by a narrow kernel (1.5 mm on a 10 mm bore, journal 9.5 mm) is curved tighter than the
+    journal: seen from a journal centre on its axis its bottom is a local maximum of the distance, the rims the
+    minima (a two-point contact). The nearest bore point is the global minimum, to 1e-12 m of a dense reference,
+    at every journal position round it (Newton's method from the angle of e alone stopped on the bottom, 10 µm too
+    far, as a worn slider-crank bore did at 11.8 ms)."""
+    bearing, journal, harmonics = 0.010, 0.0095, 64
+    sigma = wear.kernel_sigma(0.0015, harmonics, bearing)
+    rates = np.zeros(2 * harmonics + 1)
+    wear.add_kernel_rates(rates, wear.kernel_weights(sigma, harmonics), harmonics, 1.0, 0.0)
+    coefficients = rates * 1e-5 / wear.evaluate_profile(rates, np.array([0.0]))[0]  # 10 µm deep at θ = 0
+
+    def profile(theta):
+        theta = np.asarray(theta, float)
+        orders = np.arange(1, harmonics + 1)
+        phases = np.multiply.outer(theta, orders)
+        a, b = coefficients[1::2], coefficients[2::2]
+        return (coefficients[0] + np.cos(phases) @ a + np.sin(phases) @ b,
+                (-np.sin(phases) * orders) @ a + (np.cos(phases) * orders) @ b,
+                (-np.cos(phases) * orders ** 2) @ a + (-np.sin(phases) * orders ** 2) @ b)
+
+    depth_range = wear.depth_range(coefficients)
+    for angle in np.radians([-3.0, -1.0, 0.0, 0.4, 2.0, 5.0]):
+        for eccentricity in (0.49e-3, 0.505e-3):
+            e = eccentricity * np.array([np.cos(angle), np.sin(angle)])
+            theta, rx, ry, *_ = wear.closest_bore_point(coefficients, harmonics, depth_range, bearing, e[0], e[1])
+            penetration = journal - np.hypot(rx - e[0], ry - e[1])
+            expected, _ = nearest_bore_contact(profile, bearing, journal, e)
+            assert penetration == pytest.approx(expected, abs=1e-12), (np.degrees(angle), eccentricity)

@@ -17,7 +17,7 @@ from clearsim.physics.cylindrical import (
     law_state, line_contact_edge, pereira_coefficients, pereira_exponent, range_warnings,
 )
 from tests.support.impact_reference import elastic_law_impact
-from tests.validation.conftest import simulate  # noqa: F401  (the fixture: run a YAML text, read its result)
+from tests.validation.conftest import simulate, simulate_with_statistics  # noqa: F401  (the fixtures: run a YAML text, read its result)
 
 MODULUS = effective_modulus(207e9, 0.3, 207e9, 0.3)  # Pa: steel on steel, 113.7 GPa
 LENGTH, CLEARANCE = 0.05, 1e-5  # m: the breaker's pins, 50 mm long, 10 µm radial clearance

@@ -292,6 +292,17 @@ def dynamics_type(system_type):
 
 
 @njit(cache=True, inline="always")
+def wear_state_count(system):
+    """States of the accumulated Archard profiles, which end z (build.wear_arrays): 2M + 1 per wearing joint. Like the
+    integrated powers they feed nothing back within a run, so they steer no step (dopri.error_norm)."""
+    count = 0
+    for k in range(system.wear_slots.shape[0]):
+        if system.wear_slots[k, 0] >= 0:
+            count += 2 * system.wear_slots[k, 1] + 1
+    return count
+
+
+@njit(cache=True, inline="always")
 def element_states(system, y):
     """z: the force elements' states at the end of y."""
     return y[2 * coordinate_count(system) + WORK_COUNT:]

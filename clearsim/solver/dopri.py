@@ -72,15 +72,16 @@ def _scaled_square(error, y, y_new, i, rtol, atol):
 
 
 @njit(cache=True)
-def error_norm(error, y, y_new, count, skipped, rtol, atol):
+def error_norm(error, y, y_new, count, skipped, tail, rtol, atol):
     """RMS of error/(atol + rtol max(|y|, |y_new|)) over the first `count` components and those after the `skipped`
-    ones that follow them (the integrated powers, which steer no step, sit between q̇ and the element states)."""
+    ones that follow them, but for the last `tail` (the integrated powers, which steer no step, sit between q̇ and the
+    element states; the accumulated wear profiles, which steer none either, end the element states)."""
     total = 0.0
     for i in range(count):
         total += _scaled_square(error, y, y_new, i, rtol, atol)
-    for i in range(count + skipped, y.shape[0]):
+    for i in range(count + skipped, y.shape[0] - tail):
         total += _scaled_square(error, y, y_new, i, rtol, atol)
-    return np.sqrt(total / (y.shape[0] - skipped))
+    return np.sqrt(total / (y.shape[0] - skipped - tail))
 
 
 @njit(cache=True)

@@ -40,7 +40,7 @@ from clearsim.assembly.arrays import (
 )
 from clearsim.assembly.dynamics import (
     WORK_COUNT, coordinate_count, dynamics_type, effective_mass, element_states, forces_and_accelerations,
-    project_positions, project_velocities, rhs, stick_row_index,
+    project_positions, project_velocities, rhs, stick_row_index, wear_state_count,
 )
 from clearsim.assembly.forces import (
     CONTACT, FREE, SLIDE_BACK, STICK, clearance_kinematics, contact_force_magnitudes, exact_stick,
@@ -562,7 +562,7 @@ def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real
         ints[I_RHS] += evaluations
         if take_jacobian:
             ints[I_JACOBIAN_AGE] = 0
-        norm = error_norm(error, y, y_new, 2 * n, WORK_COUNT, real[R_RTOL], real[R_ATOL])
+        norm = error_norm(error, y, y_new, 2 * n, WORK_COUNT, wear_state_count(system), real[R_RTOL], real[R_ATOL])
         if not np.isfinite(norm):
             norm = 1e10
         if norm > 1.0:

@@ -159,7 +159,8 @@ def sweep_keep(quick: bool, folder: Path, measurements, repeats: int = 1) -> dic
             run_sweep(plan, LocalPool(2))
             walls[keep].append(time.perf_counter() - started)
             files = sorted(out.glob("*.h5"))
-            sizes[keep] = sum(f.stat().st_size for f in files) / len(files) / 1e6
+            sizes[keep] = (sum(f.stat().st_size for f in files) / len(files) / 1e6,
+                           sum(history_bytes(f) for f in files) / len(files) / 1e6)
             with (out / "summary.csv").open(newline="") as handle:  # the rows without the run-dependent columns
                 summaries[keep] = [{k: v for k, v in row.items() if k not in ("wall_time_s", "reused")}
                                    for row in csv.DictReader(handle)]
@@ -168,8 +169,20 @@ def sweep_keep(quick: bool, folder: Path, measurements, repeats: int = 1) -> dic
     for keep, times in walls.items():
         median = statistics.median(times)
         result[keep] = {"wall_median_s": median, "wall_min_s": min(times), "wall_max_s": max(times),
-                        "cases_per_minute": 60.0 * cases / median, "mb_per_case": sizes[keep]}
+                        "cases_per_minute": 60.0 * cases / median, "mb_per_case": sizes[keep][0],
+                        "history_mb_per_case": sizes[keep][1]}
     return result
+
+
+def history_bytes(path: Path) -> int:
+    """Bytes of a result file's datasets, uncompressed: what `--keep` chooses, without the file's fixed part
+    (attributes, episode tables, HDF5 metadata) and without the compression, whose chunks follow the run's flushes."""
+    import h5py
+
+    sizes = []
+    with h5py.File(path, "r") as file:
+        file.visititems(lambda name, item: sizes.append(item.nbytes) if isinstance(item, h5py.Dataset) else None)
+    return sum(sizes)
 
 
 def describe(name: str, result) -> str:

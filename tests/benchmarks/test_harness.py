@@ -121,6 +121,10 @@ def test_the_sweep_keep_benchmark_compares_equal_summaries_and_the_file_sizes(tm
     result = sweep_keep(quick=True, folder=tmp_path, measurements=[], repeats=1)
     assert result["cases"] == 2 and result["repeats"] == 1 and result["same_summary"]
     full, summary = result["all"], result["summary"]
-    assert summary["mb_per_case"] < full["mb_per_case"] / 3  # the UHV's nine bodies and twelve reactions left out
+    # the UHV's nine bodies and twelve reactions left out: the histories (uncompressed; measured 0.22 against 0.74 MB
+    # a 10 ms case) — the files' sizes also hold a fixed part (attributes, episode tables) that is most of a 10 ms
+    # summary file (0.25 against 0.71 MB)
+    assert summary["history_mb_per_case"] < full["history_mb_per_case"] / 3
+    assert summary["mb_per_case"] < full["mb_per_case"]
     assert full["cases_per_minute"] == pytest.approx(60.0 * 2 / full["wall_median_s"])
     assert "same summary: True" in describe("sweep-keep", result)

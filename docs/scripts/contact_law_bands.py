@@ -19,14 +19,16 @@ Figures of each run (flexible_studies.case_figures, paper_studies.whirl): peak |
 over 0–10 ms, the start delay at 1 % of the ideal peak speed against the ideal run, the largest dry contact force
 at A and J, the largest film force at A and J and the thinnest film (lubricated), J's orbits 40–80 ms, the energy
 dissipated in the contacts and by friction, steps and wall time. Then the bands: per clearance, the range of each
-figure over the dry laws, and the lubricated value. ≈ 30 runs, ≈ 2 min of integration with the kernels cached.
+figure over the dry laws, and the lubricated value. 27 runs, ≈ 30 s of integration with the kernels cached.
 
 The oil: ISO VG 68 (ISO 3448: 68 mm²/s at 40 °C, the grade spans 61.2–74.8 mm²/s), density ≈ 880 kg/m³:
 μ = 68e-6 m²/s × 880 kg/m³ ≈ 0.060 Pa·s at 40 °C, ASSUMED as the service temperature of the mechanism housing.
 """
 
 import argparse
+import re
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -64,7 +66,7 @@ def law_cases(clearance_mm: str, lengths: list[str]) -> list[tuple[str, str, tup
 
 
 def file_name(clearance_mm: str, label: str) -> str:
-    return f"c{clearance_mm}-" + "".join(ch if ch.isalnum() or ch == "." else "-" for ch in label)
+    return f"c{clearance_mm}-" + re.sub(r"[^0-9a-zA-Z.]+", "-", label).strip("-")
 
 
 def film_figures(data) -> dict:
@@ -77,11 +79,18 @@ def film_figures(data) -> dict:
 
 
 def run_figures(path: Path, ideal) -> dict:
-    """case_figures of the run, its film figures, J's orbits 40–80 ms and the energy dissipated (J)."""
+    """case_figures of the run, its film figures, J's orbits 40–80 ms (NaN without a clearance at J) and the
+    energy dissipated (J)."""
     data = read_result(path)
     figures = case_figures(path, ideal) | film_figures(data)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        figures["orbits"] = abs(whirl(data)[0])
+    for joint in ("A", "J"):  # an ideal joint's force is its reaction
+        if not np.isfinite(figures[f"force_{joint}"]) and f"joints/{joint}/reaction" in data:
+            figures[f"force_{joint}"] = float(np.max(np.hypot(*data[f"joints/{joint}/reaction"].T))) / 1e3
+    figures["orbits"] = np.nan  # no clearance at J (the ideal run)
+    if "joints/J/eccentricity" in data:
+        with warnings.catch_warnings():  # a journal never in dry contact has no slip or contact eccentricity to average
+            warnings.simplefilter("ignore", RuntimeWarning)
+            figures["orbits"] = abs(whirl(data)[0])
     figures["contact_J"] = float(data["energy/contact_dissipated"][-1])
     figures["friction_J"] = float(data["energy/friction_dissipated"][-1])
     return figures
@@ -102,6 +111,13 @@ def cell(value, spec) -> str:
     return "—" if isinstance(value, float) and not np.isfinite(value) else format(value, spec)
 
 
+def band_cell(figures: dict, key: str) -> str:
+    """One figure of a run; a joint force with the joint's largest film force beside the dry one where there is a film."""
+    text = cell(figures[key], COLUMNS[key][1])
+    film = figures.get(key.replace("force", "film"), np.nan) if key.startswith("force") else np.nan
+    return text if not np.isfinite(film) else f"{text} (film {film:.1f})"
+
+
 def print_runs(clearance_mm: str, rows: list[tuple[str, str, dict]]):
     print(f"\nA and J at {clearance_mm} mm\n")
     print("| case | " + " | ".join(header for header, _ in COLUMNS.values()) + " |")
@@ -111,9 +127,10 @@ def print_runs(clearance_mm: str, rows: list[tuple[str, str, dict]]):
         print(f"| {label}{flag} | " + " | ".join(cell(f[k], spec) for k, (_, spec) in COLUMNS.items()) + " |")
 
 
-def print_bands(bands: dict[str, list[tuple[str, str, dict]]]):
+def print_bands(bands: dict[str, list[tuple[str, str, dict]]], ideal: dict):
     print("\n| A and J | " + " | ".join(COLUMNS[k][0] for k in BANDED) + " |")
     print("|---|" + "---|" * len(BANDED))
+    print("| ideal (no clearance; F_n: the joint's reaction) | " + " | ".join(band_cell(ideal, k) for k in BANDED) + " |")
     for clearance_mm, rows in bands.items():
         dry = [f for _, kind, f in rows if kind == "dry"]
         ranges = [f"{cell(min(f[k] for f in dry), COLUMNS[k][1])}–{cell(max(f[k] for f in dry), COLUMNS[k][1])}"
@@ -121,7 +138,7 @@ def print_bands(bands: dict[str, list[tuple[str, str, dict]]]):
         print(f"| {clearance_mm} mm, dry, every law | " + " | ".join(ranges) + " |")
         for label, kind, f in rows:
             if kind == "lubricated":
-                print(f"| {clearance_mm} mm, {label} | " + " | ".join(cell(f[k], COLUMNS[k][1]) for k in BANDED) + " |")
+                print(f"| {clearance_mm} mm, {label} | " + " | ".join(band_cell(f, k) for k in BANDED) + " |")
 
 
 def command_line(arguments):
@@ -137,14 +154,15 @@ def command_line(arguments):
 def main():
     options = command_line(sys.argv[1:])
     lengths, clearances = options.lengths.split(","), options.clearances.split(",")
-    ideal = read_result(run_case(options.out, "ideal", IDEAL, CONFIG))
+    ideal_file = run_case(options.out, "ideal", IDEAL, CONFIG)
+    ideal = read_result(ideal_file)
     bands = {}
     for clearance_mm in clearances:
         bands[clearance_mm] = [(label, kind, run_figures(run_case(options.out, file_name(clearance_mm, label),
                                                                   overrides, CONFIG), ideal))
                                for label, kind, overrides in law_cases(clearance_mm, lengths)]
         print_runs(clearance_mm, bands[clearance_mm])
-    print_bands(bands)
+    print_bands(bands, run_figures(ideal_file, ideal))
     print(f"\nlubricated: viscosity {VISCOSITY}, dry_below 1.5 µm (default), {LUBRICATED_METHOD[0]}")
 
 

@@ -1,10 +1,11 @@
 """docs/validation.md §6, "Under each contact law and lubricated": the breaker's headline figures under each elastic
 law of docs/model-contact.md and with greased pins, and their bands.
 
-    python docs/scripts/contact_law_bands.py [OUT] [--lengths 50,40] [--clearances 0.01,0.1]
-        (result files under OUT, default /tmp/clearsim-contact-law-bands; complete ones are reused)
+    python docs/scripts/contact_law_bands.py [OUT] [--lengths 50,40] [--clearances 0.01,0.1] [--config FILE]
+        (result files under OUT, default /tmp/clearsim-contact-law-bands; complete ones are reused: use another OUT
+        for another FILE)
 
-configs/uhv_breaker.yaml with A and J at each clearance, run
+configs/uhv_breaker.yaml (or FILE, e.g. configs/uhv_breaker_hydraulic.yaml) with A and J at each clearance, run
 - dry, under each elastic law: the file's point law (Meng 2015's K) and `point_hertz` with `stiffness: auto`,
   `pereira`, `johnson`, `esdu_78035` and `liu` (with the file's `law: lankarani_nikravesh` damping, `liu` is the
   Bai–Zhao hybrid) at each pin length L (ASSUMED: the model and the paper give none);
@@ -116,6 +117,11 @@ def cell(value, spec) -> str:
     return "—" if isinstance(value, float) and not np.isfinite(value) else format(value, spec)
 
 
+def value_range(low, high, spec) -> str:
+    """"low–high", or "low to high" where a dash would read as a minus sign."""
+    return f"{cell(low, spec)}{' to ' if low < 0 else '–'}{cell(high, spec)}"
+
+
 def band_cell(figures: dict, key: str) -> str:
     """One figure of a run; a joint force with the joint's largest film force beside the dry one where there is a film."""
     text = cell(figures[key], COLUMNS[key][1])
@@ -138,8 +144,7 @@ def print_bands(bands: dict[str, list[tuple[str, str, dict]]], ideal: dict):
     print("| ideal (no clearance; F_n: the joint's reaction) | " + " | ".join(band_cell(ideal, k) for k in BANDED) + " |")
     for clearance_mm, rows in bands.items():
         dry = [f for _, kind, f in rows if kind == "dry"]
-        ranges = [f"{cell(min(f[k] for f in dry), COLUMNS[k][1])}–{cell(max(f[k] for f in dry), COLUMNS[k][1])}"
-                  for k in BANDED]
+        ranges = [value_range(min(f[k] for f in dry), max(f[k] for f in dry), COLUMNS[k][1]) for k in BANDED]
         print(f"| {clearance_mm} mm, dry, every law | " + " | ".join(ranges) + " |")
         for label, kind, f in rows:
             if kind == "lubricated":
@@ -151,6 +156,8 @@ def command_line(arguments):
     parser.add_argument("out", nargs="?", type=Path, default=Path("/tmp/clearsim-contact-law-bands"))
     parser.add_argument("--lengths", default="50,40", help="pin lengths L in mm (ASSUMED), comma-separated")
     parser.add_argument("--clearances", default="0.01,0.1", help="clearances at A and J in mm, comma-separated")
+    parser.add_argument("--config", type=Path, default=CONFIG, help="the model (default the bundled breaker); the "
+                        "start delay is measured against its own ideal run")
     options = parser.parse_args(arguments)
     options.out.mkdir(parents=True, exist_ok=True)
     return options
@@ -159,12 +166,12 @@ def command_line(arguments):
 def main():
     options = command_line(sys.argv[1:])
     lengths, clearances = options.lengths.split(","), options.clearances.split(",")
-    ideal_file = run_case(options.out, "ideal", IDEAL, CONFIG)
+    ideal_file = run_case(options.out, "ideal", IDEAL, options.config)
     ideal = read_result(ideal_file)
     bands = {}
     for clearance_mm in clearances:
         bands[clearance_mm] = [(label, kind, run_figures(run_case(options.out, file_name(clearance_mm, label),
-                                                                  overrides, CONFIG), ideal))
+                                                                  overrides, options.config), ideal))
                                for label, kind, overrides in law_cases(clearance_mm, lengths)]
         print_runs(clearance_mm, bands[clearance_mm])
     print_bands(bands, run_figures(ideal_file, ideal))

@@ -58,6 +58,8 @@ CASES = [
     # the breaker with greased pins (docs/model-contact.md, "Cost"), its journals started 1 µm off-centre (a centred
     # start leaves the film's line of centres to round-off: docs/model.md §4), both methods over the first 1 ms
     *[Case(f"uhv-lubricated{suffix}", UHV, LUBRICATED + ("solver.t_end=1ms",) + method) for suffix, method in METHODS],
+    # the same over the whole 85 ms stroke, rosenbrock only (dopri5 would take ~20 min): against uhv-c0.01, dry
+    Case("uhv-lubricated-stroke-rosenbrock", UHV, LUBRICATED + METHODS[1][1], ("solver.t_end=10ms",)),
     # the flexible breaker's crank arms at the beam element's default of 10 segments (their highest modes bound
     # dopri5's steps), ideal pins, first 10 ms, both methods
     *[Case(f"uhv-flex-n10-ideal{suffix}", UHV_FLEXIBLE, ("joints.A.clearance=0", "joints.J.clearance=0",

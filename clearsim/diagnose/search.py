@@ -221,7 +221,7 @@ AS_GIVEN = "the model as given"
 
 def setting(candidates: list[Candidate], values) -> str:
     """'clearance in joint B, clearance = 0.082 mm' (several effects: joined by '; ')."""
-    return "; ".join(f"{c.label}, {c.parameter} = {c.shown(v)}" for c, v in zip(candidates, values))
+    return "; ".join(c.finding(v) for c, v in zip(candidates, values))
 
 
 def evaluate_points(evaluator: Tracked, record: Record, sensors: list[str],

@@ -473,7 +473,8 @@ def seen_below_chaos(scored: Scored, baseline: Point, record: Record) -> bool:
 
 
 def effect_line(effect: Effect) -> str:
-    """'clearance in joint B, clearance = 0.082 mm (0.071–0.094 mm); gap 14.2 → 1.3 (−91%)'."""
+    """'clearance in joint B, clearance = 0.082 mm (0.071–0.094 mm); gap 14.2 → 1.3 (−91%)', 'joint B worn 0.05 mm
+    around 120° (0.04–0.06 mm); …'."""
     c, scored = effect.candidate, effect.scored
     low, high = effect.interval
     before, after = effect.before.gap, effect.point.fit.gap
@@ -484,5 +485,5 @@ def effect_line(effect: Effect) -> str:
         tell += "; it does not improve both halves of the record"
     if scored.perturbed and max(scored.perturbed) >= 0.0:
         tell += "; with the impacts re-rolled it fits worse than the model"
-    return (f"{c.label}, {c.parameter} = {c.shown(effect.value)} ({c.shown(low)}–{c.shown(high)}); "
+    return (f"{c.finding(effect.value)} ({c.shown(low)}–{c.shown(high)}); "
             f"gap {before:.3g} → {after:.3g} ({change:+.0%}){tie}{tell}")

@@ -43,6 +43,7 @@ class Candidate:
     rough: bool = False  # its cost is a comb of narrow minima: fitted on the smoothed profile (search.rough_rounds)
     pin_radius: float | None = None  # friction of an ideal pin: the journal radius its torque μ F R_J uses (m)
     angle: float | None = None  # a worn arc's angular position φ in the bearing body's frame (rad): one candidate each
+    parameters: int = 1  # quantities fitted, for the BIC's penalty: a worn arc's angle, chosen among candidates, is one
 
     @property
     def key(self) -> tuple[str, str | None, str]:
@@ -294,21 +295,34 @@ def wear(mechanism, document) -> list[Candidate]:
     """A worn arc of each clearance joint's bore (worn_arc), added to its present profile: one candidate per position
     φ = 0°, 30°, … in the bearing body's frame, its parameter the peak depth d (2 µm … 0.5 mm, or less than the
     wall's thickness leaves)."""
-    out = []
-    for joint in _clearance_joints(mechanism):
-        radius = resolve_clearance(joint, mechanism.defaults).bearing_radius
-        worn = joint.wear.profile.coefficients() if joint.wear is not None and joint.wear.profile is not None else np.zeros(1)
-        deepest = float(evaluate_profile(worn, np.linspace(0.0, 2.0 * math.pi, 360, endpoint=False)).max())
-        wall = joint.wear.wall if joint.wear is not None else None
-        high = min(WEAR_DEPTH_BOUNDS[1], wall - deepest) if wall is not None else WEAR_DEPTH_BOUNDS[1]
-        if not high > WEAR_DEPTH_BOUNDS[0]:
-            continue
-        for angle in np.arange(0.0, 2.0 * math.pi - 1e-9, WEAR_ANGLE_STEP):
-            def write(doc, value, name=joint.name, angle=float(angle), radius=radius, worn=worn):
-                _set_profile(doc, name, _summed(worn, worn_arc(value, angle, radius)))
+    angles = np.arange(0.0, 2.0 * math.pi - 1e-9, WEAR_ANGLE_STEP)
+    return [c for joint in _clearance_joints(mechanism) for c in _worn_arcs(mechanism, joint, angles)]
 
-            out.append(Candidate("wear", joint.name, "depth", "m", WEAR_DEPTH_BOUNDS[0], high, True, None, write,
-                                 ("mm", 1e-3), angle=float(angle)))
+
+def wear_between(mechanism, candidate: Candidate) -> list[Candidate]:
+    """The worn arc of a wear candidate's joint halfway to the positions beside it, φ ± 15°: its angle refined."""
+    joint = next(j for j in mechanism.joints if j.name == candidate.target)
+    return _worn_arcs(mechanism, joint, [candidate.angle - WEAR_ANGLE_STEP / 2.0, candidate.angle + WEAR_ANGLE_STEP / 2.0])
+
+
+def _worn_arcs(mechanism, joint, angles) -> list[Candidate]:
+    """A worn arc at each angle of a clearance joint's bore (none when its wall leaves no room for one)."""
+    radius = resolve_clearance(joint, mechanism.defaults).bearing_radius
+    worn = joint.wear.profile.coefficients() if joint.wear is not None and joint.wear.profile is not None else np.zeros(1)
+    deepest = float(evaluate_profile(worn, np.linspace(0.0, 2.0 * math.pi, 360, endpoint=False)).max())
+    wall = joint.wear.wall if joint.wear is not None else None
+    high = min(WEAR_DEPTH_BOUNDS[1], wall - deepest) if wall is not None else WEAR_DEPTH_BOUNDS[1]
+    if not high > WEAR_DEPTH_BOUNDS[0]:
+        return []
+    out = []
+    for angle in angles:
+        angle = float(angle) % (2.0 * math.pi)
+
+        def write(doc, value, name=joint.name, angle=angle):
+            _set_profile(doc, name, _summed(worn, worn_arc(value, angle, radius)))
+
+        out.append(Candidate("wear", joint.name, "depth", "m", WEAR_DEPTH_BOUNDS[0], high, True, None, write,
+                             ("mm", 1e-3), angle=angle, parameters=2))
     return out
 
 

@@ -89,7 +89,7 @@ def _ranking(scored: list[Scored]) -> list[dict]:
                      "smoothed_in": (None if s.smoothed is None
                                      else "screening band" if s.smoothed_in_low_band else "comparison band"),
                      "smoothed": {("screening band" if band else "comparison band"): _smoothed_value(s, profile)
-                                  for band, profile in s.profiles.items()}})
+                                  for band, profile in s.profiles.items()}} | _position(s.candidate))
     return rows
 
 

@@ -21,7 +21,7 @@ import yaml
 
 from clearsim.diagnose.align import (Fit, NoiseEstimate, NoiseTest, Record, fit_offset, noise_test, predict,
                                     prepare_record, repeat_noise, residual_noise, residuals)
-from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for, perturbed, with_effects
+from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for, perturbed, wear_between, with_effects
 from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
 from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
@@ -418,6 +418,12 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     evaluator.stage(f"iteration {number}: fitting {candidates_count(len(chosen))}")
     refine(evaluator, record, sensors, chosen, document)
     ranked = judge(scored, baseline, record)
+    between = worn_arcs_between(ranked, _mechanism(document, request), {s.candidate.key for s in scored})
+    if between:
+        evaluator.stage(f"iteration {number}: refining the worn arc's angle ({candidates_count(len(between))})")
+        refine(evaluator, record, sensors, between, document)
+        scored += between
+        ranked = judge(scored, baseline, record)
     winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
     if winner is not None and not seen_below_chaos(winner, base_point, record):
         say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) only above the screening band "
@@ -433,6 +439,14 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
+
+
+def worn_arcs_between(ranked: list[Scored], mechanism, known: set) -> list[Scored]:
+    """When the best fitted candidate is a worn arc, its joint's arcs halfway to the positions beside it (φ ± 15°), to
+    be fitted as it was: the angle refined once."""
+    if not ranked or not ranked[0].fitted or ranked[0].candidate.kind != "wear":
+        return []
+    return [Scored(c) for c in wear_between(mechanism, ranked[0].candidate) if c.key not in known]
 
 
 def ensemble_copies(document: dict, request: DiagnoseRequest) -> list[dict]:

@@ -413,6 +413,7 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
         f"{len(windows)} window(s) outside the noise band")
     visible = [s for s in scored if seen_by_sensors(s, baseline.chi_square)]
     chosen = to_fit(visible, base_point, record, request.fit_top)
+    chosen += clearances_of_worn_joints(chosen, visible)
     say(f"  screened {len(candidates)} candidates ({len(visible)} visible to the sensors); fitting "
         + ", ".join(s.candidate.label for s in chosen))
     evaluator.stage(f"iteration {number}: fitting {candidates_count(len(chosen))}")
@@ -439,6 +440,14 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
+
+
+def clearances_of_worn_joints(chosen: list[Scored], visible: list[Scored]) -> list[Scored]:
+    """The clearance candidate of each joint a chosen worn arc is in, when not chosen itself: a uniform clearance
+    change is a worn arc's mean term alone, so an arc is judged against it (the twelve arcs of a joint would otherwise
+    take every place to fit)."""
+    worn = {s.candidate.target for s in chosen if s.candidate.kind == "wear"}
+    return [s for s in visible if s.candidate.kind == "clearance" and s.candidate.target in worn and s not in chosen]
 
 
 def worn_arcs_between(ranked: list[Scored], mechanism, known: set) -> list[Scored]:

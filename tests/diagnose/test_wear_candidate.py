@@ -65,6 +65,10 @@ def test_a_hidden_worn_arc_is_named_at_its_joint_its_angle_and_depth(tmp_path):
     assert effect["finding"].startswith("joint slider_pin worn ") and f"around {effect['angle_deg']:.0f}°" in effect["finding"]
     assert effect["finding"] in (tmp_path / "report" / "report.md").read_text()
     assert found["gap_after"] < 0.3 * found["gap_before"]
+    ranking = found["iterations"][0]["ranking"]
+    refined = {r["angle_deg"] for r in ranking if r["kind"] == "wear" and round(r["angle_deg"]) % 30}
+    assert len(refined) == 2 and all(r["fitted"] for r in ranking if r["kind"] == "wear" and r["angle_deg"] in refined)
+    assert all(r["fitted"] for r in ranking if r["kind"] == "clearance")  # the arc is judged against the clearance
 
 
 def test_a_record_of_the_unworn_model_names_no_wear(tmp_path):

@@ -17,6 +17,8 @@ from typing import Callable
 
 import numpy as np
 
+from clearsim.life.run import _profile_text as profile_block
+from clearsim.life.run import _summed as summed_profiles
 from clearsim.model.flexible import initial_tensions, link_split, point_text, set_spring, split_link, two_joint_links
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.resolve import is_clearance_joint, resolve_clearance
@@ -268,14 +270,6 @@ def worn_arc(depth: float, angle: float, radius: float) -> np.ndarray:
     return coefficients
 
 
-def _summed(first: np.ndarray, second: np.ndarray) -> np.ndarray:
-    """Two profiles' coefficients [a_0, a_1, b_1, …] added, the shorter padded with zeros."""
-    out = np.zeros(max(len(first), len(second)))
-    out[:len(first)] += first
-    out[:len(second)] += second
-    return out
-
-
 def _set_profile(document: dict, joint: str, coefficients: np.ndarray) -> None:
     """Write a joint's `wear.profile` as `{cos: [a_0, a_1, …], sin: [b_1, …]}` in metres: the path is made and checked
     as `--set` would (with a one-term placeholder: the series is longer than an override's value may be), then the
@@ -287,8 +281,7 @@ def _set_profile(document: dict, joint: str, coefficients: np.ndarray) -> None:
     node = document
     for step in parents:
         node = node[step]
-    lengths = [si_text(v, "length") for v in coefficients]
-    node[key] = {"cos": lengths[0:1] + lengths[1::2], "sin": lengths[2::2]}
+    node[key] = profile_block(coefficients)
 
 
 def wear(mechanism, document) -> list[Candidate]:
@@ -319,7 +312,7 @@ def _worn_arcs(mechanism, joint, angles) -> list[Candidate]:
         angle = float(angle) % (2.0 * math.pi)
 
         def write(doc, value, name=joint.name, angle=angle):
-            _set_profile(doc, name, _summed(worn, worn_arc(value, angle, radius)))
+            _set_profile(doc, name, summed_profiles(worn, worn_arc(value, angle, radius)))
 
         out.append(Candidate("wear", joint.name, "depth", "m", WEAR_DEPTH_BOUNDS[0], high, True, None, write,
                              ("mm", 1e-3), angle=angle, parameters=2))

@@ -9,6 +9,7 @@ document (a dict, edited in place). To add a kind, write one function `kind(mech
 from __future__ import annotations
 
 import copy
+import math
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
@@ -16,10 +17,13 @@ from typing import Callable
 
 import numpy as np
 
+from clearsim.life.run import _profile_text as profile_block
+from clearsim.life.run import _summed as summed_profiles
 from clearsim.model.flexible import initial_tensions, link_split, point_text, set_spring, split_link, two_joint_links
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.resolve import is_clearance_joint, resolve_clearance
 from clearsim.model.schema import Mechanism, StrokeMotion
+from clearsim.physics.wear import add_kernel_rates, evaluate_profile, kernel_sigma, kernel_weights
 from clearsim.units import DIMENSIONS, si_text, to_si
 
 FAR_ANCHOR = 1000.0  # m: a damper anchored this far along its line acts in a fixed direction
@@ -40,16 +44,31 @@ class Candidate:
     resonant: bool = False  # the parameter is a stiffness setting a resonance, frequency ∝ √value (search.resonance_seeds)
     rough: bool = False  # its cost is a comb of narrow minima: fitted on the smoothed profile (search.rough_rounds)
     pin_radius: float | None = None  # friction of an ideal pin: the journal radius its torque μ F R_J uses (m)
+    angle: float | None = None  # a worn arc's angular position φ in the bearing body's frame (rad): one candidate each
+    parameters: int = 1  # quantities fitted, for the BIC's penalty: a worn arc's angle, chosen among candidates, is one
 
     @property
     def key(self) -> tuple[str, str | None, str]:
-        return self.kind, self.target, self.parameter
+        return self.kind, self.target, self.parameter + (f" {self.around}" if self.angle is not None else "")
+
+    @property
+    def around(self) -> str:
+        return f"around {math.degrees(self.angle) % 360.0:.0f}°"
 
     @property
     def label(self) -> str:
         where = f" in joint {self.target}" if self.kind in JOINT_KINDS else (f" of {self.target}" if self.target else "")
         pin = f" (pin, R = {self.pin_radius * 1e3:.3g} mm)" if self.pin_radius is not None else ""
-        return f"{KIND_TITLES.get(self.kind, self.kind)}{where}{pin}" + (f" ({self.parameter})" if self.kind in PARAMETER_NAMED else "")
+        around = f" {self.around}" if self.angle is not None else ""
+        return (f"{KIND_TITLES.get(self.kind, self.kind)}{where}{pin}{around}"
+                + (f" ({self.parameter})" if self.kind in PARAMETER_NAMED else ""))
+
+    def finding(self, value: float) -> str:
+        """The effect at a value in words: 'clearance in joint B, clearance = 0.08 mm', 'joint B worn 0.05 mm around
+        120°'."""
+        if self.kind == "wear":
+            return f"joint {self.target} worn {self.shown(value)} {self.around}"
+        return f"{self.label}, {self.parameter} = {self.shown(value)}"
 
     def applied(self, document: dict, value: float) -> dict:
         """A copy of the document with the parameter set to `value`."""
@@ -90,8 +109,8 @@ KIND_TITLES = {"clearance": "clearance", "friction": "friction", "stiffness": "c
                "compliance": "axial compliance", "beam_stiffness": "bending stiffness",
                "contact_length": "pin contact length", "port_area": "port area", "precharge": "accumulator precharge",
                "bulk_modulus": "oil bulk modulus", "preload": "spring preload", "dashpot": "dashpot",
-               "gas_load": "gas load", "guide_friction": "guide friction"}
-JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution", "contact_length"}
+               "gas_load": "gas load", "guide_friction": "guide friction", "wear": "wear"}
+JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution", "contact_length", "wear"}
 PARAMETER_NAMED = {"drive", "port_area", "dashpot"}  # kinds with several parameters per target: the label names it
 
 
@@ -232,6 +251,72 @@ def contact_length(mechanism, document) -> list[Candidate]:
 def restitution(mechanism, document) -> list[Candidate]:
     """Coefficient of restitution c_e of each clearance joint, 0.3 … 1."""
     return _contact_candidates(mechanism, "restitution", "restitution", "", lambda c0: (0.3, 1.0), False)
+
+
+WEAR_DEPTH_BOUNDS = (2e-6, 0.5e-3)  # m: peak depth d of a worn arc, 2 µm to 0.5 mm
+WEAR_ANGLE_STEP = math.radians(30.0)  # positions φ of the worn arc tried: every 30° of the bore
+WEAR_ARC = math.radians(60.0)  # the worn arc's width w = R_B · 60° (the Archard kernel's, physics/wear.py)
+WEAR_HARMONICS = 16  # harmonics of the worn arc's profile: its kernel's σ = 0.42 rad is above the ringing limit 4/16
+
+
+def worn_arc(depth: float, angle: float, radius: float) -> np.ndarray:
+    """[a_0, a_1, b_1, …] (m) of a worn arc of peak depth d at φ in a bore of radius R_B: h(θ) = d K(θ − φ)/K(0), K
+    the Archard wear kernel of width R_B · WEAR_ARC — the shape Archard wear leaves under a contact that stays at φ
+    (its mean a_0 = d · WEAR_ARC/2π is the uniform clearance the worn volume adds)."""
+    weights = kernel_weights(kernel_sigma(WEAR_ARC * radius, WEAR_HARMONICS, radius), WEAR_HARMONICS)
+    peak = (2.0 * weights.sum() - 1.0) / (2.0 * math.pi)
+    coefficients = np.zeros(1 + 2 * WEAR_HARMONICS)
+    add_kernel_rates(coefficients, weights, WEAR_HARMONICS, depth / peak, angle)
+    return coefficients
+
+
+def _set_profile(document: dict, joint: str, coefficients: np.ndarray) -> None:
+    """Write a joint's `wear.profile` as `{cos: [a_0, a_1, …], sin: [b_1, …]}` in metres: the path is made and checked
+    as `--set` would (with a one-term placeholder: the series is longer than an override's value may be), then the
+    series put in its place."""
+    applied, problems = apply_overrides(document, [f"joints.{joint}.wear.profile={{cos: [0 m]}}"], Mechanism)
+    if problems:
+        raise ValueError(f"joints.{joint}.wear.profile: {problems[0].message}")
+    *parents, key = next(iter(applied))
+    node = document
+    for step in parents:
+        node = node[step]
+    node[key] = profile_block(coefficients)
+
+
+def wear(mechanism, document) -> list[Candidate]:
+    """A worn arc of each clearance joint's bore (worn_arc), added to its present profile: one candidate per position
+    φ = 0°, 30°, … in the bearing body's frame, its parameter the peak depth d (2 µm … 0.5 mm, or less than the
+    wall's thickness leaves)."""
+    angles = np.arange(0.0, 2.0 * math.pi - 1e-9, WEAR_ANGLE_STEP)
+    return [c for joint in _clearance_joints(mechanism) for c in _worn_arcs(mechanism, joint, angles)]
+
+
+def wear_between(mechanism, candidate: Candidate) -> list[Candidate]:
+    """The worn arc of a wear candidate's joint halfway to the positions beside it, φ ± 15°: its angle refined."""
+    joint = next(j for j in mechanism.joints if j.name == candidate.target)
+    return _worn_arcs(mechanism, joint, [candidate.angle - WEAR_ANGLE_STEP / 2.0, candidate.angle + WEAR_ANGLE_STEP / 2.0])
+
+
+def _worn_arcs(mechanism, joint, angles) -> list[Candidate]:
+    """A worn arc at each angle of a clearance joint's bore (none when its wall leaves no room for one)."""
+    radius = resolve_clearance(joint, mechanism.defaults).bearing_radius
+    worn = joint.wear.profile.coefficients() if joint.wear is not None and joint.wear.profile is not None else np.zeros(1)
+    deepest = float(evaluate_profile(worn, np.linspace(0.0, 2.0 * math.pi, 360, endpoint=False)).max())
+    wall = joint.wear.wall if joint.wear is not None else None
+    high = min(WEAR_DEPTH_BOUNDS[1], wall - deepest) if wall is not None else WEAR_DEPTH_BOUNDS[1]
+    if not high > WEAR_DEPTH_BOUNDS[0]:
+        return []
+    out = []
+    for angle in angles:
+        angle = float(angle) % (2.0 * math.pi)
+
+        def write(doc, value, name=joint.name, angle=angle):
+            _set_profile(doc, name, summed_profiles(worn, worn_arc(value, angle, radius)))
+
+        out.append(Candidate("wear", joint.name, "depth", "m", WEAR_DEPTH_BOUNDS[0], high, True, None, write,
+                             ("mm", 1e-3), angle=angle, parameters=2))
+    return out
 
 
 LAG_BOUNDS = (5e-5, 10e-3)  # s
@@ -423,7 +508,7 @@ KINDS: dict[str, Callable] = {"clearance": clearance, "friction": friction, "sti
                               "compliance": compliance, "beam_stiffness": beam_stiffness,
                               "contact_length": contact_length, "port_area": port_area, "precharge": precharge,
                               "bulk_modulus": bulk_modulus, "preload": preload, "dashpot": dashpot,
-                              "gas_load": gas_load, "guide_friction": guide_friction}
+                              "gas_load": gas_load, "guide_friction": guide_friction, "wear": wear}
 
 
 def candidates_for(mechanism, document: dict, kinds: list[str], base_dir: Path | str = ".") -> list[Candidate]:

@@ -6,12 +6,14 @@ Nothing is overwritten silently: an earlier report's files are kept under number
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from clearsim.diagnose.align import INTERVAL_LEVEL, QUIET, REPEATS, TREND, predict, residuals
+from clearsim.diagnose.candidates import Candidate
 from clearsim.diagnose.evaluate import document_text
 from clearsim.diagnose.search import SIGNIFICANCE, JointFit, Scored, smoothed_interval
 from clearsim.diagnose.search import robust_to_perturbations, significant_on_both_halves
@@ -30,13 +32,18 @@ def _effect(effect: Effect, d: Diagnosis | None = None) -> dict:
     """An effect as in diagnosis.json; with the diagnosis `d`, its verdict too (confirmed, and on what)."""
     c, scored = effect.candidate, effect.scored
     low, high = effect.interval
-    return {"kind": c.kind, "target": c.target, "parameters": {c.parameter: effect.value},
+    return {"kind": c.kind, "target": c.target, "finding": c.finding(effect.value), "parameters": {c.parameter: effect.value},
             "interval": {c.parameter: [low, high]}, "unit": {c.parameter: c.unit},
             "ambiguous_with": scored.ambiguous_with, "telling_sensor": scored.telling_sensor,
             "delta_bic": scored.delta_bic, "gap": effect.point.fit.gap,
             "delta_chi_square_halves": list(scored.halves) if scored.halves else None,
             "confirmed_on_both_halves": bool(scored.halves and max(scored.halves) < 0.0),
-            "delta_chi_square_perturbed": list(scored.perturbed)} | (_verdict_of(effect, d) if d is not None else {})
+            "delta_chi_square_perturbed": list(scored.perturbed)} | _position(c) | (_verdict_of(effect, d) if d is not None else {})
+
+
+def _position(c: Candidate) -> dict:
+    """A worn arc's angular position in the bearing body's frame (degrees), for an effect that has one."""
+    return {"angle_deg": math.degrees(c.angle) % 360.0} if c.angle is not None else {}
 
 
 def _verdict_of(effect: Effect, d: Diagnosis) -> dict:
@@ -82,7 +89,7 @@ def _ranking(scored: list[Scored]) -> list[dict]:
                      "smoothed_in": (None if s.smoothed is None
                                      else "screening band" if s.smoothed_in_low_band else "comparison band"),
                      "smoothed": {("screening band" if band else "comparison band"): _smoothed_value(s, profile)
-                                  for band, profile in s.profiles.items()}})
+                                  for band, profile in s.profiles.items()}} | _position(s.candidate))
     return rows
 
 

@@ -221,7 +221,7 @@ AS_GIVEN = "the model as given"
 
 def setting(candidates: list[Candidate], values) -> str:
     """'clearance in joint B, clearance = 0.082 mm' (several effects: joined by '; ')."""
-    return "; ".join(f"{c.label}, {c.parameter} = {c.shown(v)}" for c, v in zip(candidates, values))
+    return "; ".join(c.finding(v) for c, v in zip(candidates, values))
 
 
 def evaluate_points(evaluator: Tracked, record: Record, sensors: list[str],
@@ -467,7 +467,7 @@ def judge(scored: list[Scored], baseline: Fit, record: Record) -> list[Scored]:
         if s.best is None:
             continue
         s.allowance = profile_threshold(s.best.chi_square, record)
-        s.bic = s.best.chi_square + penalty  # the evidence: the best any run did (a rough candidate's estimate is its smoothed minimum)
+        s.bic = s.best.chi_square + penalty * s.candidate.parameters  # the evidence: the best any run did (a rough candidate's estimate is its smoothed minimum)
         s.delta_bic = s.bic - baseline.chi_square
         s.interval = interval(s, record) if s.smoothed is None else smoothed_interval(s)
     ranked = sorted(scored, key=lambda s: (not s.fitted, s.bic))

@@ -21,7 +21,7 @@ import yaml
 
 from clearsim.diagnose.align import (Fit, NoiseEstimate, NoiseTest, Record, fit_offset, noise_test, predict,
                                     prepare_record, repeat_noise, residual_noise, residuals)
-from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for, perturbed, with_effects
+from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for, perturbed, wear_between, with_effects
 from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
 from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
@@ -413,11 +413,18 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
         f"{len(windows)} window(s) outside the noise band")
     visible = [s for s in scored if seen_by_sensors(s, baseline.chi_square)]
     chosen = to_fit(visible, base_point, record, request.fit_top)
+    chosen += clearances_of_worn_joints(chosen, visible)
     say(f"  screened {len(candidates)} candidates ({len(visible)} visible to the sensors); fitting "
         + ", ".join(s.candidate.label for s in chosen))
     evaluator.stage(f"iteration {number}: fitting {candidates_count(len(chosen))}")
     refine(evaluator, record, sensors, chosen, document)
     ranked = judge(scored, baseline, record)
+    between = worn_arcs_between(ranked, _mechanism(document, request), {s.candidate.key for s in scored})
+    if between:
+        evaluator.stage(f"iteration {number}: refining the worn arc's angle ({candidates_count(len(between))})")
+        refine(evaluator, record, sensors, between, document)
+        scored += between
+        ranked = judge(scored, baseline, record)
     winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
     if winner is not None and not seen_below_chaos(winner, base_point, record):
         say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) only above the screening band "
@@ -433,6 +440,22 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
+
+
+def clearances_of_worn_joints(chosen: list[Scored], visible: list[Scored]) -> list[Scored]:
+    """The clearance candidate of each joint a chosen worn arc is in, when not chosen itself: a uniform clearance
+    change is a worn arc's mean term alone, so an arc is judged against it (the twelve arcs of a joint would otherwise
+    take every place to fit)."""
+    worn = {s.candidate.target for s in chosen if s.candidate.kind == "wear"}
+    return [s for s in visible if s.candidate.kind == "clearance" and s.candidate.target in worn and s not in chosen]
+
+
+def worn_arcs_between(ranked: list[Scored], mechanism, known: set) -> list[Scored]:
+    """When the best fitted candidate is a worn arc, its joint's arcs halfway to the positions beside it (φ ± 15°), to
+    be fitted as it was: the angle refined once."""
+    if not ranked or not ranked[0].fitted or ranked[0].candidate.kind != "wear":
+        return []
+    return [Scored(c) for c in wear_between(mechanism, ranked[0].candidate) if c.key not in known]
 
 
 def ensemble_copies(document: dict, request: DiagnoseRequest) -> list[dict]:
@@ -473,7 +496,8 @@ def seen_below_chaos(scored: Scored, baseline: Point, record: Record) -> bool:
 
 
 def effect_line(effect: Effect) -> str:
-    """'clearance in joint B, clearance = 0.082 mm (0.071–0.094 mm); gap 14.2 → 1.3 (−91%)'."""
+    """'clearance in joint B, clearance = 0.082 mm (0.071–0.094 mm); gap 14.2 → 1.3 (−91%)', 'joint B worn 0.05 mm
+    around 120° (0.04–0.06 mm); …'."""
     c, scored = effect.candidate, effect.scored
     low, high = effect.interval
     before, after = effect.before.gap, effect.point.fit.gap
@@ -484,5 +508,5 @@ def effect_line(effect: Effect) -> str:
         tell += "; it does not improve both halves of the record"
     if scored.perturbed and max(scored.perturbed) >= 0.0:
         tell += "; with the impacts re-rolled it fits worse than the model"
-    return (f"{c.label}, {c.parameter} = {c.shown(effect.value)} ({c.shown(low)}–{c.shown(high)}); "
+    return (f"{c.finding(effect.value)} ({c.shown(low)}–{c.shown(high)}); "
             f"gap {before:.3g} → {after:.3g} ({change:+.0%}){tie}{tell}")

@@ -5,6 +5,8 @@
 Runs `clearsim life` and `clearsim plot` on configs/uhv_breaker_hydraulic.yaml with the wear overrides of
 docs/life.md "Worked example", then prints the blocks, the clearance growth and worn angle of each joint and the
 drift of every recorded figure (first row → last row).
+The dry case runs for hours in blocks of some 50 operations (docs/life.md): Ctrl-C keeps its rows, and the same
+command continues it.
 """
 
 import subprocess

@@ -34,6 +34,15 @@ def accumulated_coefficients(system, k: int, element_states: np.ndarray) -> np.n
     return element_states[..., first:first + 2 * harmonics + 1] * system.arrays.clearance_params[k, CL_CLEARANCE]
 
 
+def profile_basis(harmonics: int, angles: np.ndarray) -> np.ndarray:
+    """(2M + 1, angles) rows [1, cos θ, sin θ, cos 2θ, sin 2θ, …]: the depths of many profiles [a_0, a_1, b_1, …] at
+    once are coefficients @ basis (one product for a chunk's samples instead of a series per sample)."""
+    phases = np.arange(1, harmonics + 1)[:, None] * angles[None, :]
+    basis = np.empty((2 * harmonics + 1, len(angles)))
+    basis[0], basis[1::2], basis[2::2] = 1.0, np.cos(phases), np.sin(phases)
+    return basis
+
+
 def wear_histories(system, states: np.ndarray) -> dict:
     """{dataset: (values, unit)} of the chunk's samples (states: the solver's y per sample)."""
     out = {}
@@ -41,8 +50,7 @@ def wear_histories(system, states: np.ndarray) -> dict:
     z = states[:, 2 * system.coordinate_count + WORK_COUNT:]
     for k, name, parameters in archard_joints(system):
         coefficients = accumulated_coefficients(system, k, z)
-        depth = np.stack([evaluate_profile(row, grid) for row in coefficients]) if len(coefficients) else \
-            np.zeros((0, HISTORY_ANGLES))
+        depth = coefficients @ profile_basis((coefficients.shape[1] - 1) // 2, grid)
         out[f"joints/{name}/wear/max_depth"] = (depth.max(axis=1, initial=0.0), "m")
         out[f"joints/{name}/wear/volume"] = (2.0 * math.pi * parameters.bearing_radius * parameters.archard.length
                                              * coefficients[:, 0], "m^3")

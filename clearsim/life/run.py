@@ -172,6 +172,8 @@ def run_life(request: LifeRequest, progress: Callable[[int, int, int], None] = l
     def simulate(state: dict[str, np.ndarray], keep_as: str | None = None) -> Operation:
         counter["simulations"] += 1
         path = runs / (keep_as or "predicted.h5")
+        if keep_as is None:
+            path.unlink(missing_ok=True)  # a refused block's failed prediction: kept only while it is the last word
         operation = machine.simulate(state, path)
         if keep_as is None:
             path.unlink(missing_ok=True)

@@ -93,3 +93,22 @@ def test_the_life_command_prints_its_summary_and_plots_its_pages(pin_config, pin
     result = runner.invoke(app, ["life", str(pin_config), "-n", "10", "-o", str(tmp_path / "short.h5")])
     assert result.exit_code == 0, result.output
     assert "joint J: largest clearance" in result.output and "10 operations" in result.output
+
+
+def test_refused_predictions_leave_no_operation_files(pin_config, tmp_path, monkeypatch):
+    from clearsim.life import run
+
+    original, failures = run.Machine.simulate, {"left": 3}
+
+    def failing_predictions(machine, state, output):
+        if output.name == "predicted.h5" and failures["left"] > 0:  # a prediction the solver could not finish
+            failures["left"] -= 1
+            output.write_bytes(b"a failed run's partial file")
+            raise run.WornOperationFailed(f"{output}: did not complete")
+        return original(machine, state, output)
+
+    monkeypatch.setattr(run.Machine, "simulate", failing_predictions)
+    report = run_life(LifeRequest(pin_config, 2500, tmp_path / "life.h5"))
+    assert report.complete and failures["left"] == 0
+    left = sorted(path.name for path in (tmp_path / "life-operations").iterdir())
+    assert not [name for name in left if name.startswith("predicted")], left

@@ -17,13 +17,13 @@ from typing import Callable
 
 import numpy as np
 
-from clearsim.life.run import _profile_text as profile_block
-from clearsim.life.run import _summed as summed_profiles
 from clearsim.model.flexible import initial_tensions, link_split, point_text, set_spring, split_link, two_joint_links
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.resolve import is_clearance_joint, resolve_clearance
 from clearsim.model.schema import Mechanism, StrokeMotion
-from clearsim.physics.wear import add_kernel_rates, evaluate_profile, kernel_sigma, kernel_weights
+from clearsim.physics.wear import (
+    add_kernel_rates, evaluate_profile, kernel_sigma, kernel_weights, profile_block, summed_coefficients,
+)
 from clearsim.units import DIMENSIONS, si_text, to_si
 
 FAR_ANCHOR = 1000.0  # m: a damper anchored this far along its line acts in a fixed direction
@@ -312,7 +312,7 @@ def _worn_arcs(mechanism, joint, angles) -> list[Candidate]:
         angle = float(angle) % (2.0 * math.pi)
 
         def write(doc, value, name=joint.name, angle=angle):
-            _set_profile(doc, name, summed_profiles(worn, worn_arc(value, angle, radius)))
+            _set_profile(doc, name, summed_coefficients(worn, worn_arc(value, angle, radius)))
 
         out.append(Candidate("wear", joint.name, "depth", "m", WEAR_DEPTH_BOUNDS[0], high, True, None, write,
                              ("mm", 1e-3), angle=angle, parameters=2))

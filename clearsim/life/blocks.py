@@ -26,6 +26,8 @@ from typing import Callable
 
 import numpy as np
 
+from clearsim.physics.wear import evaluate_profile
+
 PROFILE_ANGLES = 720  # the depth norm's grid: every 0.5°
 
 
@@ -62,18 +64,10 @@ class Block:
     refused: int
 
 
-def profile_depth(coefficients: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """h(θ) = a_0 + Σ_m (a_m cos mθ + b_m sin mθ) of coefficients [a_0, a_1, b_1, a_2, b_2, …] (docs/life.md)."""
-    harmonics = (len(coefficients) - 1) // 2
-    orders = np.arange(1, harmonics + 1)
-    phases = np.outer(angles, orders)
-    return coefficients[0] + np.cos(phases) @ coefficients[1::2][:harmonics] + np.sin(phases) @ coefficients[2::2][:harmonics]
-
-
 def largest_depth(coefficients: np.ndarray) -> float:
     """max over θ of |h(θ)| on a 0.5° grid."""
     angles = np.linspace(0.0, 2.0 * math.pi, PROFILE_ANGLES, endpoint=False)
-    return float(np.max(np.abs(profile_depth(coefficients, angles))))
+    return float(np.max(np.abs(evaluate_profile(coefficients, angles))))
 
 
 def error_ratio(start: Operation, predicted: Operation, size: int, allowances: dict[str, float]) -> float:

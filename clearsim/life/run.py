@@ -4,7 +4,6 @@ bores, repeat to N (docs/life.md). The block control is clearsim/life/blocks.py,
 from __future__ import annotations
 
 import copy
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -12,12 +11,13 @@ from typing import Callable
 import h5py
 import numpy as np
 
-from clearsim.errors import ClearsimError, Problem, InputError
+from clearsim.errors import ClearsimError
 from clearsim.io.files import keep_as_previous
-from clearsim.life.blocks import Block, BlockControl, Operation, OperationFailed, live, profile_depth
+from clearsim.life.blocks import Block, BlockControl, Operation, OperationFailed, live
 from clearsim.life.store import ANGLES, LifeFile, is_life_file
 from clearsim.model.loader import LoadedMechanism, dump_yaml, load_mechanism, load_mechanism_text
 from clearsim.model.resolve import resolve_clearance
+from clearsim.physics.wear import evaluate_profile, profile_block, summed_coefficients
 from clearsim.runner import check_output_path, prepare, run_to_file, summarize
 
 MAX_OPERATIONS = 10_000_000
@@ -52,31 +52,6 @@ class LifeReport:
     backup: Path | None
 
 
-def _profile_coefficients(profile) -> np.ndarray:
-    """[a_0, a_1, b_1, …] (m) of a file's `wear.profile` (its cos and sin lists)."""
-    cosines, sines = list(profile.cos) or [0.0], list(profile.sin)
-    harmonics = max(len(cosines) - 1, len(sines))
-    coefficients = np.zeros(2 * harmonics + 1)
-    coefficients[0] = cosines[0]
-    for m in range(1, harmonics + 1):
-        coefficients[2 * m - 1] = cosines[m] if m < len(cosines) else 0.0
-        coefficients[2 * m] = sines[m - 1] if m - 1 < len(sines) else 0.0
-    return coefficients
-
-
-def _summed(first: np.ndarray, second: np.ndarray) -> np.ndarray:
-    total = np.zeros(max(len(first), len(second)))
-    total[:len(first)] += first
-    total[:len(second)] += second
-    return total
-
-
-def _profile_text(coefficients: np.ndarray) -> dict:
-    """A `wear.profile` block (cos, sin lists with their unit) of coefficients [a_0, a_1, b_1, …] in m."""
-    return {"cos": [f"{value!r} m" for value in coefficients[0::2][:1].tolist() + coefficients[1::2].tolist()],
-            "sin": [f"{value!r} m" for value in coefficients[2::2].tolist()]}
-
-
 class Machine:
     """The mechanism of a life: its wearing joints (those with `wear: {archard: …}`), their clearances and the
     profiles the file starts from; runs one operation with the bores worn by a life state."""
@@ -92,22 +67,22 @@ class Machine:
             parameters = resolve_clearance(joint, mechanism.defaults)
             self.clearances[joint.name] = parameters.clearance
             self.harmonics[joint.name] = wear.archard.harmonics
-            self.initial[joint.name] = _profile_coefficients(wear.profile) if wear.profile is not None else np.zeros(1)
+            self.initial[joint.name] = wear.profile.coefficients() if wear.profile is not None else np.zeros(1)
         if not self.clearances:
             raise LifeError(f"{loaded.path}: no joint wears: a life needs at least one clearance joint with an "
                             "Archard law\n  hint: add e.g. `wear: {archard: {coefficient: 1e-6, hardness: 2 GPa}}` to "
                             "joint J (docs/yaml.md, joints → wear)")
 
     def initial_depth(self) -> dict[str, np.ndarray]:
-        return {joint: profile_depth(coefficients, ANGLES) for joint, coefficients in self.initial.items()}
+        return {joint: evaluate_profile(coefficients, ANGLES) for joint, coefficients in self.initial.items()}
 
     def worn(self, state: dict[str, np.ndarray]) -> LoadedMechanism:
         """The mechanism with each wearing joint's profile = the file's + the life's."""
         document = copy.deepcopy(self.loaded.document)
         for item in document["joints"]:
             if item.get("name") in state:
-                total = _summed(self.initial[item["name"]], state[item["name"]])
-                item["wear"] = dict(item["wear"]) | {"profile": _profile_text(total)}
+                total = summed_coefficients(self.initial[item["name"]], state[item["name"]])
+                item["wear"] = dict(item["wear"]) | {"profile": profile_block(total)}
         return load_mechanism_text(dump_yaml(document), name=str(self.loaded.path), base_dir=self.loaded.base_dir)
 
     def simulate(self, state: dict[str, np.ndarray], output: Path) -> Operation:
@@ -127,7 +102,7 @@ class Machine:
 
 
 def max_depth(coefficients: np.ndarray) -> float:
-    return float(profile_depth(coefficients, ANGLES).max())
+    return float(evaluate_profile(coefficients, ANGLES).max())
 
 
 def operation_figures(path: Path) -> dict[str, float]:

@@ -23,7 +23,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from clearsim.life.blocks import PROFILE_ANGLES, Block, Operation, profile_depth
+from clearsim.life.blocks import PROFILE_ANGLES, Block, Operation
+from clearsim.physics.wear import evaluate_profile
 
 KIND = "clearsim life"
 ANGLES = np.linspace(0.0, 2.0 * math.pi, PROFILE_ANGLES, endpoint=False)
@@ -74,7 +75,7 @@ class LifeFile:
         _append(file["error_ratio"], block.error_ratio)
         clearances = json.loads(file.attrs["clearances_m"])
         for joint, clearance in clearances.items():
-            depth = initial_depth[joint] + profile_depth(block.state[joint], ANGLES)
+            depth = initial_depth[joint] + evaluate_profile(block.state[joint], ANGLES)
             _append(file[f"joints/{joint}/coefficients"], block.state[joint])
             _append(file[f"joints/{joint}/wear_per_operation"], block.operation.wear[joint])
             _append(file[f"joints/{joint}/depth"], depth)

@@ -147,6 +147,20 @@ def add_kernel_rates(rates, weights, harmonics, scale, theta):
 # --- set-up (Python) ------------------------------------------------------------------------------
 
 
+def summed_coefficients(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """The profile h_1 + h_2 of two coefficient vectors [a_0, a_1, b_1, …] of any lengths."""
+    total = np.zeros(max(len(first), len(second)))
+    total[:len(first)] += first
+    total[:len(second)] += second
+    return total
+
+
+def profile_block(coefficients: np.ndarray) -> dict:
+    """The YAML `wear.profile` block (cos and sin lists with their unit) of coefficients [a_0, a_1, b_1, …] in m."""
+    return {"cos": [f"{value!r} m" for value in coefficients[0::2][:1].tolist() + coefficients[1::2].tolist()],
+            "sin": [f"{value!r} m" for value in coefficients[2::2].tolist()]}
+
+
 def evaluate_profile(coefficients, angles) -> np.ndarray:
     """h(θ) on an array of angles (rad), for any number of harmonics."""
     coefficients = np.asarray(coefficients, float)

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from clearsim.life.blocks import Block, BlockControl, Operation, largest_depth, live, profile_depth
+from clearsim.life.blocks import Block, BlockControl, Operation, largest_depth, live
 
 CLEARANCE = 1e-4  # m
 OPERATIONS = 10_000
@@ -26,11 +26,8 @@ def counting(law):
     return simulate, calls
 
 
-def test_the_profile_is_its_fourier_series():
-    angles = np.array([0.0, 0.5, 2.0])
-    coefficients = np.array([1.0, 0.2, -0.3, 0.05, 0.07])
-    expected = 1.0 + 0.2 * np.cos(angles) - 0.3 * np.sin(angles) + 0.05 * np.cos(2 * angles) + 0.07 * np.sin(2 * angles)
-    assert np.allclose(profile_depth(coefficients, angles), expected, rtol=0, atol=1e-15)
+def test_the_error_norm_is_the_largest_depth_over_the_bore():
+    assert largest_depth(np.array([0.0, 0.0, 0.0, -3.0, 4.0])) == pytest.approx(5.0, rel=1e-4)  # on the 0.5° grid
     assert largest_depth(np.array([0.0, 0.0, 0.0, 3.0, 4.0])) == pytest.approx(5.0, rel=1e-4)  # on the 0.5° grid
 
 

@@ -6,9 +6,10 @@ import pytest
 from typer.testing import CliRunner
 
 from clearsim.cli import app
-from clearsim.life.blocks import Block, Operation, profile_depth
+from clearsim.life.blocks import Block, Operation
 from clearsim.life.store import ANGLES, LifeFile, is_life_file, life_rows
 from clearsim.plot.life import life_figures, shown_rows
+from clearsim.physics.wear import evaluate_profile
 
 CLEARANCES = {"A": 1e-5, "J": 2e-5}
 HARMONICS = {"A": 2, "J": 1}
@@ -23,7 +24,7 @@ def block(operations, scale):
 
 @pytest.fixture
 def life(tmp_path):
-    initial = {"A": np.zeros(len(ANGLES)), "J": profile_depth(np.array([1e-6, 0.0, 5e-7]), ANGLES)}
+    initial = {"A": np.zeros(len(ANGLES)), "J": evaluate_profile(np.array([1e-6, 0.0, 5e-7]), ANGLES)}
     path = tmp_path / "life.h5"
     file = LifeFile.create(path, {"config_yaml": "x", "tolerance": 0.02, "operations": 100}, CLEARANCES, HARMONICS)
     for operations, scale in ((0, 0.0), (10, 1.0), (40, 2.0)):
@@ -39,7 +40,7 @@ def test_a_life_file_holds_a_row_per_block_and_continues_from_its_last(life):
     with h5py.File(path, "r") as file:
         assert list(file["operations"][()]) == [0, 10, 40]
         depth = file["joints/J/depth"][2]
-        expected = initial["J"] + profile_depth(block(40, 2.0).state["J"], ANGLES)
+        expected = initial["J"] + evaluate_profile(block(40, 2.0).state["J"], ANGLES)
         assert np.allclose(depth, expected, rtol=0, atol=1e-18)
         assert file["joints/J/clearance"][2] == pytest.approx(CLEARANCES["J"] + expected.max(), rel=1e-12)
         assert file["figures/operating_time_s"][1] == pytest.approx(0.06801)

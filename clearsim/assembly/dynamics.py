@@ -291,7 +291,7 @@ def dynamics_type(system_type):
     return types.FunctionType(result(system_type, types.float64, vector, vector, vector, integers, vector))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def wear_state_count(system):
     """States of the accumulated Archard profiles, which end z (build.wear_arrays): 2M + 1 per wearing joint. Like the
     integrated powers they feed nothing back within a run, so they steer no step (dopri.error_norm)."""

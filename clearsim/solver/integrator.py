@@ -512,6 +512,7 @@ def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real
     """Integrate until t_stop, the end, a full buffer, STEPS_PER_CALL tried steps or a failure; the status is
     ints[I_STATUS]."""
     n = coordinate_count(system)
+    unsteering_tail = wear_state_count(system)  # the wear states end y and steer no step: fixed at assembly
     stages = np.empty((STAGES, y.shape[0]))
     y_new = np.empty_like(y)
     scratch = np.empty_like(y)
@@ -562,7 +563,7 @@ def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real
         ints[I_RHS] += evaluations
         if take_jacobian:
             ints[I_JACOBIAN_AGE] = 0
-        norm = error_norm(error, y, y_new, 2 * n, WORK_COUNT, wear_state_count(system), real[R_RTOL], real[R_ATOL])
+        norm = error_norm(error, y, y_new, 2 * n, WORK_COUNT, unsteering_tail, real[R_RTOL], real[R_ATOL])
         if not np.isfinite(norm):
             norm = 1e10
         if norm > 1.0:

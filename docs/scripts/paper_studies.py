@@ -25,6 +25,7 @@ import yaml
 
 from clearsim.io.hdf5 import read_result
 from clearsim.sweep.figures import start_time
+from clearsim.units import parse_quantity
 from clearsim.whirl import orbit_angle, orbit_rate
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -180,10 +181,8 @@ def joint_bodies(data, joint):
 
 
 def _metres(text):
-    if isinstance(text, (int, float)):
-        return float(text)
-    value, unit = str(text).split()
-    return float(value) * {"m": 1.0, "mm": 1e-3, "um": 1e-6}[unit]
+    """A length of the file in metres ("0.01 mm", "0.01mm", "10 um" or a number in metres), read as the model reads it."""
+    return float(parse_quantity(text).to("m").magnitude) if isinstance(text, str) else float(text)
 
 
 def friction_by_joint(data, joint):

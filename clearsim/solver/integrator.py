@@ -186,8 +186,9 @@ def _root(system, dynamics, k, kind, t, y, stages, h, lo, hi, modes, speeds, scr
 
 
 @njit(cache=True, inline="always")
-def first_event(system, dynamics, k, kind, t, y, y_new, stages, h, modes, speeds, scratch):
-    """θ in (0, 1] of joint k's first event of this kind in the step, or 2.0 when there is none."""
+def first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, modes, speeds, scratch):
+    """θ in (0, 1] of joint k's first event of this kind in the step, or 2.0 when there is none (points: the step's
+    continuous extension at its subdivisions, fill_subdivisions)."""
     mode = modes[k]
     if kind == TANGENTIAL and (mode == FREE or not exact_stick(system, k)):
         return 2.0
@@ -198,7 +199,7 @@ def first_event(system, dynamics, k, kind, t, y, y_new, stages, h, modes, speeds
         if i == SUBDIVISIONS:
             g, r = event_value(system, dynamics, k, kind, t + h, y_new, modes, speeds)
         else:
-            g, r = _value_at(system, dynamics, k, kind, t, y, stages, h, theta, modes, speeds, scratch)
+            g, r = event_value(system, dynamics, k, kind, t + theta * h, points[i], modes, speeds)
         if _crossed(mode, kind, g_prev, g):
             return _root(system, dynamics, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
         turning = (r_prev > 0.0 and r < 0.0) if mode == FREE else (r_prev < 0.0 and r > 0.0)
@@ -212,14 +213,14 @@ def first_event(system, dynamics, k, kind, t, y, y_new, stages, h, modes, speeds
 
 
 @njit(cache=True, inline="always")
-def earliest_event(system, dynamics, t, y, y_new, stages, h, modes, speeds, scratch):
+def earliest_event(system, dynamics, t, y, y_new, stages, h, points, modes, speeds, scratch):
     """(θ, joint, kind) of the step's first event, or (2.0, −1, NORMAL) when there is none."""
     event_theta = 2.0
     event_joint = np.int64(-1)  # int64 from the start: a literal would compile each callee once more for it
     event_kind = np.int64(NORMAL)
     for k in range(modes.shape[0]):
         for kind in range(2):
-            theta = first_event(system, dynamics, k, kind, t, y, y_new, stages, h, modes, speeds, scratch)
+            theta = first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, modes, speeds, scratch)
             if theta < event_theta:
                 event_theta, event_joint, event_kind = theta, k, kind
     return event_theta, event_joint, event_kind
@@ -400,17 +401,31 @@ def free_flight_limit(system, y, modes):
     return limit
 
 
-@njit(cache=True)
-def normal_force_at(system, k, y, stages, h, theta, modes, speeds, scratch):
-    """F_n of joint k at t + θh on the step's continuous extension."""
+@njit(cache=True, inline="always")
+def normal_force(system, k, state, modes, speeds):
+    """F_n of joint k in a state."""
     n = coordinate_count(system)
-    interpolate(y, stages, h, theta, scratch)
-    kin = clearance_kinematics(system, k, scratch[:n], scratch[n:2 * n])
+    kin = clearance_kinematics(system, k, state[:n], state[n:2 * n])
     return contact_force_magnitudes(system, k, kin[4], kin[5], kin[8], modes[k], speeds[k])[0]
 
 
+@njit(cache=True)
+def normal_force_at(system, k, y, stages, h, theta, modes, speeds, scratch):
+    """F_n of joint k at t + θh on the step's continuous extension."""
+    interpolate(y, stages, h, theta, scratch)
+    return normal_force(system, k, scratch, modes, speeds)
+
+
 @njit(cache=True, inline="always")
-def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
+def fill_subdivisions(y, stages, h, points):
+    """points[i] = the step's continuous extension at θ = i/SUBDIVISIONS, i = 0 … SUBDIVISIONS: interpolated once
+    per step for the event search and the peak search of every joint."""
+    for i in range(SUBDIVISIONS + 1):
+        interpolate(y, stages, h, i / SUBDIVISIONS, points[i])
+
+
+@njit(cache=True, inline="always")
+def update_peaks(system, y, stages, h, points, modes, speeds, peak_force, scratch):
     """Raise peak_force[k] to the largest F_n of the step: at 4 points, then at an interior maximum.
 
     A maximum near the sampled one that could raise the peak so far is refined by golden-section
@@ -423,7 +438,7 @@ def update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch):
             continue
         best, best_theta = -1.0, 0.0
         for i in range(SUBDIVISIONS + 1):
-            force = normal_force_at(system, k, y, stages, h, i / SUBDIVISIONS, modes, speeds, scratch)
+            force = normal_force(system, k, points[i], modes, speeds)
             if force > best:
                 best, best_theta = force, i / SUBDIVISIONS
         if best < PEAK_CANDIDATE * peak_force[k]:
@@ -516,6 +531,7 @@ def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real
     stages = np.empty((STAGES, y.shape[0]))
     y_new = np.empty_like(y)
     scratch = np.empty_like(y)
+    points = np.empty((SUBDIVISIONS + 1, y.shape[0]))
     ints[I_STATUS] = RUNNING
     capacity = out_t.shape[0]
     attempts = 0
@@ -577,11 +593,13 @@ def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real
             continue
         real[R_STEP] = h * min(10.0, max(0.2, SAFETY * norm ** exponent)) if norm > 0.0 else 10.0 * h
         ints[I_JACOBIAN_AGE] += 1
-        event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, modes, speeds,
-                                                              scratch)
+        fill_subdivisions(y, stages, h, points)
+        event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, points, modes,
+                                                              speeds, scratch)
         if event_joint >= 0:
             h = refine_event(system, dynamics, projection, implicit_step, event_joint, event_kind, t, y, f,
                              event_theta * h, modes, speeds, stages, y_new, real, ints, jacobian, jacobian_modes)
+            fill_subdivisions(y, stages, h, points)  # the step integrated again, to the event
         emit_samples(system, dynamics, projection, implicit_step, t, y, f, stages, h, t + h, modes, speeds,
                      episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
                      scratch)
@@ -591,7 +609,7 @@ def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real
             if violation > DRIFT_LIMIT:
                 ints[I_STATUS] = DRIFT
                 return
-        update_peaks(system, y, stages, h, modes, speeds, peak_force, scratch)
+        update_peaks(system, y, stages, h, points, modes, speeds, peak_force, scratch)
         copy_into(y, y_new)
         real[R_TIME] = t + h if h < real[R_T_END] - t else real[R_T_END]
         ints[I_STEPS] += 1

@@ -23,7 +23,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from clearsim.assembly.arrays import copy_into
+from clearsim.assembly.arrays import CL_VISCOSITY, copy_into
+from clearsim.assembly.kinematics import GROUND
 from clearsim.assembly.dynamics import WORK_COUNT, coordinate_count, rhs
 from clearsim.solver import dopri
 
@@ -75,14 +76,43 @@ def jacobian_is_stale(age, modes, jacobian_modes):
 
 
 @njit(cache=True)
+def film_columns(system, y):
+    """True for the columns of J whose rhs the oil film of a lubricated joint depends on: q and q̇ of the bearing and
+    the journal of each joint with a viscosity (evaluate_jacobian takes these by central differences)."""
+    n = coordinate_count(system)
+    central = np.zeros(y.shape[0], np.bool_)
+    for k in range(system.clearance_bodies.shape[0]):
+        if system.clearance_params[k, CL_VISCOSITY] <= 0.0:
+            continue
+        for side in range(2):
+            body = system.clearance_bodies[k, side]
+            if body == GROUND:
+                continue
+            for c in range(3):
+                central[3 * body + c] = True
+                central[n + 3 * body + c] = True
+    return central
+
+
+@njit(cache=True)
 def evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, skipped_from, skipped_count, floor, jacobian,
                       jacobian_modes):
-    """∂f/∂y into jacobian[:, :ny] and ∂f/∂t into jacobian[:, ny] by forward differences from f = f(t, y)
-    (increments √ε max(|y_j|, floor), in time √ε max(|t|, h), at most h/2); the columns of the integrated powers
-    (skipped_from, skipped_count: f does not depend on them) are zero. Returns the rhs evaluations made."""
+    """∂f/∂y into jacobian[:, :ny] and ∂f/∂t into jacobian[:, ny] by differences from f = f(t, y) (increments
+    √ε max(|y_j|, floor), in time √ε max(|t|, h), at most h/2): forward differences, but central ones in the columns
+    an oil film depends on (film_columns); the columns of the integrated powers (skipped_from, skipped_count: f does
+    not depend on them) are zero. Returns the rhs evaluations made.
+
+    The film force is homogeneous of degree one in its rates (ε̇, ε w) and turns with their direction (the
+    cavitated half moves with it), so it is curved on the scale of the relative speed in the film, c |(2ε̇, ε w)|
+    (~1e-5 m/s), not of the bodies' speeds: a forward difference with the increment √ε |v| ≈ 7e-8 m/s at |v| = 5 m/s
+    is off by ~1 % in the film's block, and the step then leaves a fast transient of the film (λ ≈ 3e8 1/s) that
+    the error control does not see in q̇ but the accelerations do (docs/performance.md, "Stiff models"). A central
+    difference cancels the error's first-order term."""
     ny = y.shape[0]
     shifted = y.copy()
     column = np.empty(ny)
+    back = np.empty(ny)
+    central = film_columns(system, y)
     count = 0
     for j in range(ny):
         if skipped_from <= j < skipped_from + skipped_count:
@@ -93,10 +123,17 @@ def evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, skipped_from,
         shifted[j] = y[j] + increment
         increment = shifted[j] - y[j]  # the increment as represented
         rhs(system, dynamics, t, shifted, modes, speeds, column)
-        shifted[j] = y[j]
-        for i in range(ny):
-            jacobian[i, j] = (column[i] - f[i]) / increment
         count += 1
+        if central[j]:
+            shifted[j] = y[j] - increment
+            rhs(system, dynamics, t, shifted, modes, speeds, back)
+            count += 1
+            for i in range(ny):
+                jacobian[i, j] = (column[i] - back[i]) / (2.0 * increment)
+        else:
+            for i in range(ny):
+                jacobian[i, j] = (column[i] - f[i]) / increment
+        shifted[j] = y[j]
     increment = min(ROUNDOFF * max(abs(t), h), 0.5 * h)
     rhs(system, dynamics, t + increment, y, modes, speeds, column)
     for i in range(ny):
@@ -106,10 +143,10 @@ def evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, skipped_from,
 
 
 @njit(cache=True)
-def jacobian_evaluations(y):
-    """The rhs evaluations evaluate_jacobian makes for a state like y: one per column but the integrated powers', and
-    one for ∂f/∂t."""
-    return y.shape[0] - WORK_COUNT + 1
+def jacobian_evaluations(system, y):
+    """The rhs evaluations evaluate_jacobian makes for a state like y: one per column but the integrated powers',
+    one more per film column (film_columns), and one for ∂f/∂t."""
+    return y.shape[0] - WORK_COUNT + 1 + np.count_nonzero(film_columns(system, y))
 
 
 @njit(cache=True)

@@ -7,12 +7,14 @@ exact Jacobian and order 2 with any matrix in its place (a W-method). In Hairer 
     (I − hγJ) k_i = h f(t + α_i h, y + Σ_j<i α_ij k_j) + hJ Σ_j<i γ_ij k_j + γ_i h² f_t,   y₁ = y + Σ b_i k_i
 
 and computed in the transformed variables u_i = Σ_j≤i γ_ij k_j (HW II (7.4')), so that each stage is one solve with
-W = I/(hγ) − J (LU-factored once per step) and no product with J:
+W = I/(hγ) − J (LU-factored once per step, reduced_matrix) and no product with J:
 
     W u_i = f(t + α_i h, y + Σ_j<i a_ij u_j) + Σ_j<i (c_ij / h) u_j + γ_i h f_t,   y₁ = y + Σ m_i u_i,
     a = α Γ⁻¹,  c = −Γ⁻¹ off the diagonal,  m = bᵀ Γ⁻¹,  the error estimate Σ e_i u_i with e = (b − b̂)ᵀ Γ⁻¹.
 
-J = ∂f/∂y and f_t = ∂f/∂t are forward differences of the compiled rhs (evaluate_jacobian). The continuous extension
+J = ∂f/∂y and f_t = ∂f/∂t are differences of the compiled rhs (evaluate_jacobian: central in the columns an oil film
+depends on, forward elsewhere; those kept over SLOW_COLUMNS_MAX_AGE Jacobians), and W is factored with the positions
+eliminated (reduced_matrix: the first n rows of f are q̇). The continuous extension
 is the cubic Hermite interpolant of y, f(y) at both ends (local error O(h⁴), the method's order), written as the
 stage vectors of DOPRI5's dense form (dopri.interpolate), so that event location, samples and peak search read
 both methods' steps alike.
@@ -56,11 +58,15 @@ TIME_WEIGHTS = GAMMAS.sum(axis=1)  # γ_i (with the diagonal)
 # the Hermite cubic's coefficient vectors c_p (of θ, θ², θ³, over h) → DOPRI5 stage vectors K = S c with S the first
 # three columns of P (PᵀP)⁻¹, P = dopri.DENSE (7 × 4): then h Σ_j K_j Σ_p P_jp θ^(p+1) = h Σ_p c_p θ^(p+1), no θ⁴
 HERMITE_STAGES = (dopri.DENSE @ np.linalg.inv(dopri.DENSE.T @ dopri.DENSE))[:, :3].copy()
-# J is taken anew after this many accepted steps (evaluate_jacobian; docs/model.md §4): 1, a J for each new step,
+# J is taken anew after this many accepted steps (evaluate_jacobian, which then takes the film columns and, when
+# refreshes_all_columns, every column; docs/model.md §4): 1, a J for each new step,
 # kept through its rejected attempts and its event refinement. Reusing it longer, as a W-method may, cost more than it
 # saved on the squeeze film (ε 0 → 0.9 in tests/validation/test_lubricated_joint.py): up to 20 steps, 4 573 steps and
 # 3 567 rejected (0.18 s); up to 3, 3 566 rejected; 1: 2 972 steps and 6 rejected (0.09 s)
 JACOBIAN_MAX_AGE = 1
+# the columns no oil film depends on are taken anew after this many Jacobians (refreshes_all_columns): the greased
+# breaker's stroke (2 185 steps) with 10: 1.75 s of integration against 2.49 s with every column at each step, the
+# same peak to 4e-6; the film's position columns kept with them too: 7 763 steps, peak 260 against 195 m/s²
 SLOW_COLUMNS_MAX_AGE = 10
 ROUNDOFF = np.sqrt(np.finfo(np.float64).eps)
 

@@ -49,7 +49,7 @@ OFF_CENTRE = ("joints.A.initial_eccentricity=[0 m, -1 um]", "joints.J.initial_ec
 CYLINDRICAL = ("pereira", "johnson", "esdu_78035", "liu")
 FILE_LAW = "point_hertz, K of the file"
 # the faster method with a film (see above; dry runs keep dopri5), at rtol 1e-9: at the default 1e-7 the peaks agree
-# (3.5e-6) but samples inside a long step drift by up to 16 m/s² (docs/model.md §4, "Limits"); min_step as the
+# (3.5e-6) but samples differ by up to 9.4 m/s² (docs/model.md §4, "Limits"); min_step as the
 # benchmark's lubricated cases (the film's start-up transient)
 LUBRICATED_SOLVER = ("solver.method=rosenbrock", "solver.rtol=1e-9", "solver.atol=1e-12", "solver.min_step=1e-13 s")
 

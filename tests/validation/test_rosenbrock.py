@@ -164,6 +164,10 @@ def test_the_greased_breakers_accelerations_at_the_default_tolerance_match_a_100
     assert peak > 150.0  # precondition: the stroke has begun (m/s²)
     assert np.max(np.abs(acceleration)) == pytest.approx(peak, rel=1e-3)
     np.testing.assert_allclose(acceleration, expected, rtol=0, atol=0.01 * peak)
+    deviation = np.sqrt(np.mean((acceleration - expected) ** 2))
+    # each sample inside a step stepped from the sample before it (integrator.emit_samples): 9.7e-5 measured; 4.8e-4
+    # with each stepped from the step's start, the fast film transient of a long sub-step left in it
+    assert deviation <= 2.5e-4 * peak
     for joint in "AJ":
         film, film_expected = (np.hypot(*run[f"joints/{joint}/film_force"].T) for run in (default, tighter))
         np.testing.assert_allclose(film, film_expected, rtol=0, atol=0.01 * np.max(film_expected))

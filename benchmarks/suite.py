@@ -55,8 +55,8 @@ CASES = [
     *[Case(f"uhv-{law}", UHV, (f"defaults.contact.elastic={law}", "defaults.contact.length=50mm",
                                "defaults.contact.stiffness=auto"), ("solver.t_end=10ms",))
       for law in ("johnson", "pereira", "liu")],  # one per elastic-law family: implicit line, power fit, conformal
-    # the breaker with greased pins (docs/model-contact.md, "Cost"), its journals started 1 µm off-centre (a centred
-    # start leaves the film's line of centres to round-off: docs/model.md §4), both methods over the first 1 ms
+    # the breaker with greased pins (docs/model-contact.md, "Cost"), its journals started 1 µm off-centre (as the
+    # rtol 1e-9 runs of docs/validation.md §6), both methods over the first 1 ms
     *[Case(f"uhv-lubricated{suffix}", UHV, LUBRICATED + ("solver.t_end=1ms",) + method) for suffix, method in METHODS],
     # the same over the whole 85 ms stroke, rosenbrock only (dopri5 would take ~20 min): against uhv-c0.01, dry
     Case("uhv-lubricated-stroke-rosenbrock", UHV, LUBRICATED + METHODS[1][1], ("solver.t_end=10ms",)),

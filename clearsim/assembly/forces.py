@@ -32,7 +32,7 @@ from clearsim.assembly.drivelines import driveline_potential
 from clearsim.physics.contact import damped_force
 from clearsim.physics.cylindrical import law_state
 from clearsim.physics.friction import STICK_EXACT, friction_coefficient, sliding_coefficient
-from clearsim.physics.lubrication import film_force, film_torque
+from clearsim.physics.lubrication import film_force, film_torque, line_of_centres
 from clearsim.physics.wear import add_kernel_rates, closest_bore_point
 
 # modes of a clearance joint, constant within a step. CONTACT is any contact of a smooth friction
@@ -237,9 +237,10 @@ MAX_FILM_ECCENTRICITY = 1.0 - 1e-9  # ε of a trial stage beyond the wall (rejec
 def film_state(system, k, q, qd):
     """(ε, ε̇, wedge speed ω_J + ω_B − 2φ̇, ω_J − ω_B) of lubricated joint k (docs/model-contact.md)."""
     p = system.clearance_params[k]
-    ex, ey, dex, dey, _, rate, nx, ny, _ = clearance_kinematics(system, k, q, qd)
-    eccentricity = np.sqrt(ex * ex + ey * ey)
-    orbit_rate = (-ny * dex + nx * dey) / eccentricity if eccentricity > 1e-300 else 0.0
+    ex, ey, dex, dey = clearance_kinematics(system, k, q, qd)[:4]
+    nx, ny, eccentricity = line_of_centres(ex, ey, dex, dey, p[CL_CLEARANCE])
+    rate = nx * dex + ny * dey
+    orbit_rate = (-ny * dex + nx * dey) / eccentricity if eccentricity > 0.0 else 0.0
     wj = body_rates(qd, system.clearance_bodies[k, 1])[2]
     wb = body_rates(qd, system.clearance_bodies[k, 0])[2]
     eps = min(eccentricity / p[CL_CLEARANCE], MAX_FILM_ECCENTRICITY)
@@ -264,7 +265,8 @@ def add_film_forces(system, k, q, qd, generalized):
     point P_J); return the power the film takes out, −F·(v_J − v_B)(P_J) − T (ω_J − ω_B)."""
     p = system.clearance_params[k]
     fn, ft, torque, spin = film_forces(system, k, q, qd)
-    ex, ey, dex, dey, _, _, nx, ny, _ = clearance_kinematics(system, k, q, qd)
+    ex, ey, dex, dey = clearance_kinematics(system, k, q, qd)[:4]
+    nx, ny = line_of_centres(ex, ey, dex, dey, p[CL_CLEARANCE])[:2]
     fx = fn * nx - ft * ny
     fy = fn * ny + ft * nx
     bearing = system.clearance_bodies[k, 0]

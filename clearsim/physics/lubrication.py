@@ -30,6 +30,28 @@ SMALL_ECCENTRICITY = 1e-4  # below it the film integrals use their Taylor series
 LONG_BEARING_SAMPLES = 48  # sign samples per turn when the long bearing's zero-pressure angles are searched
 
 
+CENTRED = 1e-12  # ε below which the journal counts as centred (line_of_centres)
+
+
+@njit(cache=True)
+def line_of_centres(ex, ey, dex, dey, clearance):
+    """(n_x, n_y, |e|) of the film: n = e/|e|, but along ė for a journal centred to below CENTRED·c, with |e| = 0.
+
+    At ε → 0 the film force tends to one that depends on ė alone, whatever n: the rates (2ε̇, εw) tend to
+    (2/c)(n·ė, −t·ė) (εφ̇ = t·ė/c), so the pressure ∝ ė·(cos θ, sin θ) in the frame of any n, i.e. the
+    squeeze film opposing ė. It is that limit only if t·ė enters through εφ̇, which needs |e| > 0: at |e| = 0 (a
+    journal started centred) φ̇ has no value and the film would ignore the part of ė across an arbitrary n. Taking
+    n along ė gives the limit with φ̇ = 0; below CENTRED·c the wedge term ε(ω_J + ω_B) it drops is 1e-12 of a
+    squeeze term, and e of round-off size (1e-16 m for a mechanism drawn 1 m from the origin) is noise anyway."""
+    eccentricity = math.sqrt(ex * ex + ey * ey)
+    if eccentricity >= CENTRED * clearance:
+        return ex / eccentricity, ey / eccentricity, eccentricity
+    speed = math.sqrt(dex * dex + dey * dey)
+    if speed > 0.0:
+        return dex / speed, dey / speed, 0.0
+    return 1.0, 0.0, 0.0
+
+
 @njit(cache=True, inline="always")
 def _film_thickness_ratio(theta, eps):
     """D = 1 − ε cos θ: the film thickness over c."""

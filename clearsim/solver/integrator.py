@@ -247,15 +247,19 @@ def emit_samples(system, dynamics, projection, implicit_step, t, y, f, stages, h
     """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives
     from them (derive_sample)."""
     dt = real[R_SAMPLE_DT]
+    # where a rosenbrock sample's own step starts: the step's start, then the sample before (model.md §4)
+    origin_t, origin_y, origin_f = t, y, f
     while ints[I_NEXT_SAMPLE] < ints[I_TOTAL_SAMPLES]:
         sample_time = min(ints[I_NEXT_SAMPLE] * dt, real[R_T_END])
         if sample_time > t_next:
             break
         row = ints[I_SAMPLES]
-        if h > 0.0 and ints[I_METHOD] == ROSENBROCK and t < sample_time < t + h:
+        chained = h > 0.0 and ints[I_METHOD] == ROSENBROCK and t < sample_time < t + h
+        if chained:
             # a step of its own to the sample: the Hermite extension is not damped like the step (model.md §4)
-            ints[I_RHS] += method_step(system, dynamics, implicit_step, t, y, f, sample_time - t, modes, speeds,
-                                       np.empty_like(stages), scratch, real, ints, jacobian, jacobian_modes, False)[1]
+            ints[I_RHS] += method_step(system, dynamics, implicit_step, origin_t, origin_y, origin_f,
+                                       sample_time - origin_t, modes, speeds, np.empty_like(stages), scratch, real,
+                                       ints, jacobian, jacobian_modes, False)[1]
         elif h > 0.0:
             interpolate(y, stages, h, (sample_time - t) / h, scratch)
         else:
@@ -268,6 +272,10 @@ def emit_samples(system, dynamics, projection, implicit_step, t, y, f, stages, h
         copy_into(out_episode[row], episode_of)
         derive_sample(system, dynamics, sample_time, scratch, modes, speeds, out_qdd[row], out_lam[row],
                       out_contact[row], out_energies[row])
+        if chained:
+            origin_t, origin_y, origin_f = sample_time, scratch.copy(), np.empty_like(f)
+            rhs(system, dynamics, sample_time, origin_y, modes, speeds, origin_f)
+            ints[I_RHS] += 1
         ints[I_SAMPLES] += 1
         ints[I_NEXT_SAMPLE] += 1
 
@@ -487,7 +495,7 @@ def method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stag
     if ints[I_METHOD] == ROSENBROCK:
         error = implicit_step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian, jacobian_modes,
                               take_jacobian, real[R_ATOL] / real[R_RTOL])
-        taken = rosenbrock.jacobian_evaluations(y) if take_jacobian else 0
+        taken = rosenbrock.jacobian_evaluations(system, y, jacobian_modes) if take_jacobian else 0
         return error, rosenbrock.STAGES + taken
     return step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new), 6
 

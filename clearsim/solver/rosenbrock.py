@@ -7,12 +7,14 @@ exact Jacobian and order 2 with any matrix in its place (a W-method). In Hairer 
     (I − hγJ) k_i = h f(t + α_i h, y + Σ_j<i α_ij k_j) + hJ Σ_j<i γ_ij k_j + γ_i h² f_t,   y₁ = y + Σ b_i k_i
 
 and computed in the transformed variables u_i = Σ_j≤i γ_ij k_j (HW II (7.4')), so that each stage is one solve with
-W = I/(hγ) − J (LU-factored once per step) and no product with J:
+W = I/(hγ) − J (LU-factored once per step, reduced_matrix) and no product with J:
 
     W u_i = f(t + α_i h, y + Σ_j<i a_ij u_j) + Σ_j<i (c_ij / h) u_j + γ_i h f_t,   y₁ = y + Σ m_i u_i,
     a = α Γ⁻¹,  c = −Γ⁻¹ off the diagonal,  m = bᵀ Γ⁻¹,  the error estimate Σ e_i u_i with e = (b − b̂)ᵀ Γ⁻¹.
 
-J = ∂f/∂y and f_t = ∂f/∂t are forward differences of the compiled rhs (evaluate_jacobian). The continuous extension
+J = ∂f/∂y and f_t = ∂f/∂t are differences of the compiled rhs (evaluate_jacobian: central in the columns an oil film
+depends on, forward elsewhere; those kept over SLOW_COLUMNS_MAX_AGE Jacobians), and W is factored with the positions
+eliminated (reduced_matrix: the first n rows of f are q̇). The continuous extension
 is the cubic Hermite interpolant of y, f(y) at both ends (local error O(h⁴), the method's order), written as the
 stage vectors of DOPRI5's dense form (dopri.interpolate), so that event location, samples and peak search read
 both methods' steps alike.
@@ -23,7 +25,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from clearsim.assembly.arrays import copy_into
+from clearsim.assembly.arrays import CL_VISCOSITY, copy_into
+from clearsim.assembly.kinematics import GROUND
 from clearsim.assembly.dynamics import WORK_COUNT, coordinate_count, rhs
 from clearsim.solver import dopri
 
@@ -55,11 +58,16 @@ TIME_WEIGHTS = GAMMAS.sum(axis=1)  # γ_i (with the diagonal)
 # the Hermite cubic's coefficient vectors c_p (of θ, θ², θ³, over h) → DOPRI5 stage vectors K = S c with S the first
 # three columns of P (PᵀP)⁻¹, P = dopri.DENSE (7 × 4): then h Σ_j K_j Σ_p P_jp θ^(p+1) = h Σ_p c_p θ^(p+1), no θ⁴
 HERMITE_STAGES = (dopri.DENSE @ np.linalg.inv(dopri.DENSE.T @ dopri.DENSE))[:, :3].copy()
-# J is taken anew after this many accepted steps (evaluate_jacobian; docs/model.md §4): 1, a J for each new step,
+# J is taken anew after this many accepted steps (evaluate_jacobian, which then takes the film columns and, when
+# refreshes_all_columns, every column; docs/model.md §4): 1, a J for each new step,
 # kept through its rejected attempts and its event refinement. Reusing it longer, as a W-method may, cost more than it
 # saved on the squeeze film (ε 0 → 0.9 in tests/validation/test_lubricated_joint.py): up to 20 steps, 4 573 steps and
 # 3 567 rejected (0.18 s); up to 3, 3 566 rejected; 1: 2 972 steps and 6 rejected (0.09 s)
 JACOBIAN_MAX_AGE = 1
+# the columns no oil film depends on are taken anew after this many Jacobians (refreshes_all_columns): the greased
+# breaker's stroke (2 185 steps) with 10: 1.75 s of integration against 2.49 s with every column at each step, the
+# same peak to 4e-6; the film's position columns kept with them too: 7 763 steps, peak 260 against 195 m/s²
+SLOW_COLUMNS_MAX_AGE = 10
 ROUNDOFF = np.sqrt(np.finfo(np.float64).eps)
 
 
@@ -75,16 +83,64 @@ def jacobian_is_stale(age, modes, jacobian_modes):
 
 
 @njit(cache=True)
+def film_columns(system, y):
+    """True for the columns of J whose rhs the oil film of a lubricated joint depends on: q and q̇ of the bearing and
+    the journal of each joint with a viscosity (evaluate_jacobian takes these by central differences)."""
+    n = coordinate_count(system)
+    central = np.zeros(y.shape[0], np.bool_)
+    for k in range(system.clearance_bodies.shape[0]):
+        if system.clearance_params[k, CL_VISCOSITY] <= 0.0:
+            continue
+        for side in range(2):
+            body = system.clearance_bodies[k, side]
+            if body == GROUND:
+                continue
+            for c in range(3):
+                central[3 * body + c] = True
+                central[n + 3 * body + c] = True
+    return central
+
+
+@njit(cache=True)
+def refreshes_all_columns(modes, jacobian_modes):
+    """evaluate_jacobian takes every column anew, not only the film's: none taken yet, the contact modes changed since
+    the last full one, or it has served SLOW_COLUMNS_MAX_AGE Jacobians (jacobian_modes[-1], below)."""
+    served = jacobian_modes[modes.shape[0]]
+    if served == 0 or served >= SLOW_COLUMNS_MAX_AGE:
+        return True
+    for k in range(modes.shape[0]):
+        if modes[k] != jacobian_modes[k]:
+            return True
+    return False
+
+
+@njit(cache=True)
 def evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, skipped_from, skipped_count, floor, jacobian,
                       jacobian_modes):
-    """∂f/∂y into jacobian[:, :ny] and ∂f/∂t into jacobian[:, ny] by forward differences from f = f(t, y)
-    (increments √ε max(|y_j|, floor), in time √ε max(|t|, h), at most h/2); the columns of the integrated powers
-    (skipped_from, skipped_count: f does not depend on them) are zero. Returns the rhs evaluations made."""
+    """∂f/∂y into jacobian[:, :ny] and ∂f/∂t into jacobian[:, ny] by differences from f = f(t, y) (increments
+    √ε max(|y_j|, floor), in time √ε max(|t|, h), at most h/2): forward differences, but central ones in the columns
+    an oil film depends on (film_columns); the columns of the integrated powers (skipped_from, skipped_count: f does
+    not depend on them) are zero. The other columns are kept from the last full Jacobian while it has served fewer
+    than SLOW_COLUMNS_MAX_AGE and the modes are those it was taken in (refreshes_all_columns); jacobian_modes holds
+    those modes and, in its last slot, the Jacobians taken since (1 right after a full one, 0 before the first).
+    Returns the rhs evaluations made.
+
+    The film force is homogeneous of degree one in its rates (ε̇, ε w) and turns with their direction (the
+    cavitated half moves with it), so it is curved on the scale of the relative speed in the film, c |(2ε̇, ε w)|
+    (~1e-5 m/s), not of the bodies' speeds: a forward difference with the increment √ε |v| ≈ 7e-8 m/s at |v| = 5 m/s
+    is off by ~1 % in the film's block, and the step then leaves a fast transient of the film (λ ≈ 3e8 1/s) that
+    the error control does not see in q̇ but the accelerations do (docs/performance.md, "Stiff models"). A central
+    difference cancels the error's first-order term."""
     ny = y.shape[0]
     shifted = y.copy()
     column = np.empty(ny)
+    back = np.empty(ny)
+    central = film_columns(system, y)
+    every_column = refreshes_all_columns(modes, jacobian_modes)
     count = 0
     for j in range(ny):
+        if not (every_column or central[j]):
+            continue
         if skipped_from <= j < skipped_from + skipped_count:
             for i in range(ny):
                 jacobian[i, j] = 0.0
@@ -93,23 +149,34 @@ def evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, skipped_from,
         shifted[j] = y[j] + increment
         increment = shifted[j] - y[j]  # the increment as represented
         rhs(system, dynamics, t, shifted, modes, speeds, column)
-        shifted[j] = y[j]
-        for i in range(ny):
-            jacobian[i, j] = (column[i] - f[i]) / increment
         count += 1
+        if central[j]:
+            shifted[j] = y[j] - increment
+            rhs(system, dynamics, t, shifted, modes, speeds, back)
+            count += 1
+            for i in range(ny):
+                jacobian[i, j] = (column[i] - back[i]) / (2.0 * increment)
+        else:
+            for i in range(ny):
+                jacobian[i, j] = (column[i] - f[i]) / increment
+        shifted[j] = y[j]
     increment = min(ROUNDOFF * max(abs(t), h), 0.5 * h)
     rhs(system, dynamics, t + increment, y, modes, speeds, column)
     for i in range(ny):
         jacobian[i, ny] = (column[i] - f[i]) / increment
     copy_into(jacobian_modes, modes)
+    jacobian_modes[modes.shape[0]] = 1 if every_column else jacobian_modes[modes.shape[0]] + 1
     return count + 1
 
 
 @njit(cache=True)
-def jacobian_evaluations(y):
-    """The rhs evaluations evaluate_jacobian makes for a state like y: one per column but the integrated powers', and
-    one for ∂f/∂t."""
-    return y.shape[0] - WORK_COUNT + 1
+def jacobian_evaluations(system, y, jacobian_modes):
+    """The rhs evaluations the last evaluate_jacobian made for a state like y: after a full one, one per column but
+    the integrated powers'; else one per film column (film_columns); one more per film column, and one for ∂f/∂t."""
+    film = np.count_nonzero(film_columns(system, y))
+    if jacobian_modes[jacobian_modes.shape[0] - 1] == 1:
+        return y.shape[0] - WORK_COUNT + film + 1
+    return 2 * film + 1
 
 
 @njit(cache=True)
@@ -168,17 +235,51 @@ def lu_solve(matrix, pivots, b):
 
 
 @njit(cache=True)
+def reduced_matrix(jacobian, hg, n, matrix):
+    """The iteration matrix W = I/(hγ) − J with the positions eliminated, into matrix ((ny − n)², hg = hγ).
+
+    The first n rows of f are q̇ itself, so J's are [0 I 0]: the q rows of W u = b read u_q/(hγ) − u_q̇ = b_q, i.e.
+    u_q = hγ (b_q + u_q̇), and the other rows r become (I/(hγ) − J_rr − hγ J_rq E) u_r = b_r + hγ J_rq b_q, with r the
+    q̇, W and z rows and columns and E the q̇ part of u_r (reduced_solve). The LU is then of (ny − n)² instead of
+    ny², (1 − n/ny)³ of its cost (0.2 on the breaker: 38 of 65)."""
+    ny = jacobian.shape[0]
+    size = ny - n
+    for a in range(size):
+        i = n + a
+        for b in range(size):
+            matrix[a, b] = -jacobian[i, n + b]
+        for b in range(n):
+            matrix[a, b] -= hg * jacobian[i, b]
+        matrix[a, a] += 1.0 / hg
+
+
+@njit(cache=True)
+def reduced_solve(matrix, pivots, jacobian, hg, n, b, reduced):
+    """Solve W u = b with reduced_matrix's LU (lu_factor): b overwritten by u; `reduced` (ny − n) is scratch."""
+    size = reduced.shape[0]
+    for a in range(size):
+        value = b[n + a]
+        for c in range(n):
+            value += hg * jacobian[n + a, c] * b[c]
+        reduced[a] = value
+    lu_solve(matrix, pivots, reduced)
+    for c in range(n):
+        b[c] = hg * (b[c] + reduced[c])
+    for a in range(size):
+        b[n + a] = reduced[a]
+
+
+@njit(cache=True)
 def step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian):
     """One ROS34PW2 step from (t, y) with ẏ(t) = f and J, f_t in jacobian; fills y_new and, as DOPRI5 stage vectors
     (dopri.interpolate), the Hermite continuous extension; returns (the error vector, the rhs evaluations made)."""
     ny = y.shape[0]
-    matrix = np.empty((ny, ny))
-    for i in range(ny):
-        for j in range(ny):
-            matrix[i, j] = -jacobian[i, j]
-        matrix[i, i] += 1.0 / (h * GAMMA)
-    pivots = np.empty(ny, np.int64)
+    n = coordinate_count(system)
+    matrix = np.empty((ny - n, ny - n))
+    pivots = np.empty(ny - n, np.int64)
+    reduced_matrix(jacobian, h * GAMMA, n, matrix)
     lu_factor(matrix, pivots)
+    reduced = np.empty(ny - n)
     units = np.zeros((STAGES, ny))
     work = np.empty(ny)
     argument = np.empty(ny)
@@ -197,7 +298,7 @@ def step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian):
                 work[i] += COUPLING[s, j] / h * units[j, i]
         for i in range(ny):
             work[i] += TIME_WEIGHTS[s] * h * jacobian[i, ny]
-        lu_solve(matrix, pivots, work)
+        reduced_solve(matrix, pivots, jacobian, h * GAMMA, n, work, reduced)
         copy_into(units[s], work)
     error = np.zeros(ny)
     copy_into(y_new, y)

@@ -12,7 +12,7 @@ configs/uhv_breaker.yaml (or FILE, e.g. configs/uhv_breaker_hydraulic.yaml) with
 - dry, the file's point law, the journals started 1 µm below their bearings' centres (the lubricated runs' start);
 - lubricated: `defaults.lubrication: {viscosity: VISCOSITY, length: L}` (short bearing, half-Sommerfeld, the
   default film → dry threshold `dry_below` 1.5 µm, the file's point law below it), the journals started 1 µm below
-  their bearings' centres (a centred start leaves the film's direction to round-off: docs/model.md §4), with
+  their bearings' centres (as the dry control), with
   `solver.method: rosenbrock`: the squeeze film bounds dopri5's steps (at 0.01 mm 140× slower on the first ms,
   docs/performance.md "Stiff models"; at 0.1 mm, L = 50 mm, 3.95 s of integration against rosenbrock's 1.60 s);
   at rtol 1e-9 (LUBRICATED_SOLVER below).
@@ -48,9 +48,9 @@ VISCOSITY = "0.06Pa*s"  # ISO VG 68 at 40 °C (see above)
 OFF_CENTRE = ("joints.A.initial_eccentricity=[0 m, -1 um]", "joints.J.initial_eccentricity=[0 m, -1 um]")
 CYLINDRICAL = ("pereira", "johnson", "esdu_78035", "liu")
 FILE_LAW = "point_hertz, K of the file"
-# the faster method with a film (see above; dry runs keep dopri5), at rtol 1e-9: at the default 1e-7 the stiff film
-# lets the output acceleration ring (0.01 mm, L = 50 mm: samples up to 187 m/s² off the rtol 1e-9 run, peak 224
-# against 195 m/s²); min_step as the benchmark's lubricated cases (the film's start-up transient)
+# the faster method with a film (see above; dry runs keep dopri5), at rtol 1e-9: at the default 1e-7 the peaks agree
+# (3.5e-6) but samples differ by up to 9.4 m/s² (docs/model.md §4, "Limits"); min_step as the
+# benchmark's lubricated cases (the film's start-up transient)
 LUBRICATED_SOLVER = ("solver.method=rosenbrock", "solver.rtol=1e-9", "solver.atol=1e-12", "solver.min_step=1e-13 s")
 
 

@@ -120,3 +120,27 @@ def test_range_warnings_name_the_joint_and_the_model_outside_its_length_to_diame
     [text] = lub.film_range_warnings("J", lub.LONG_BEARING, MU, 0.1, 0.05)
     assert "long_bearing" in text
     assert lub.film_range_warnings("J", lub.SHORT_BEARING, 0.0, 0.1, 0.05) == []  # a dry joint has no film
+
+
+def _film_force_vector(e, e_rate, spin_sum):
+    """The short-bearing film force on the journal as a global vector, built as assembly/forces.py does: the line of
+    centres (lub.line_of_centres), ε, ε̇ = n·ė/c and the wedge speed ω_J + ω_B − 2φ̇ with φ̇ = t·ė/|e|."""
+    nx, ny, eccentricity = lub.line_of_centres(e[0], e[1], e_rate[0], e_rate[1], C)
+    orbit_rate = (-ny * e_rate[0] + nx * e_rate[1]) / eccentricity if eccentricity > 0.0 else 0.0
+    fn, ft = lub.short_bearing_force(MU, R, L, C, eccentricity / C, (nx * e_rate[0] + ny * e_rate[1]) / C,
+                                     spin_sum - 2.0 * orbit_rate)
+    return np.array([fn * nx - ft * ny, fn * ny + ft * nx])
+
+
+@pytest.mark.parametrize("e_rate", [(0.0, -2e-6), (3e-7, 1e-6), (-1e-6, 0.0)])
+def test_a_centred_journal_feels_the_squeeze_film_of_its_whole_velocity(e_rate):
+    """At e = 0 exactly (a journal started centred) the force is the limit of ε → 0 from any direction (the
+    squeeze film opposing ė); with n = (1, 0) and φ̇ = 0 the film ignored ė's part across n (zero force for ė
+    along y)."""
+    e_rate = np.array(e_rate)
+    centred = _film_force_vector((0.0, 0.0), e_rate, 20.0)
+    for angle in (0.3, 2.0, -2.5):
+        near = _film_force_vector(1e-9 * C * np.array([math.cos(angle), math.sin(angle)]), e_rate, 20.0)
+        np.testing.assert_allclose(centred, near, rtol=0, atol=1e-6 * np.linalg.norm(near))
+    assert centred @ e_rate < -0.99 * np.linalg.norm(centred) * np.linalg.norm(e_rate)  # opposes ė
+    np.testing.assert_array_equal(_film_force_vector((0.0, 0.0), np.zeros(2), 20.0), np.zeros(2))

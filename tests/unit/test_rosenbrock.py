@@ -79,3 +79,22 @@ def test_lu_solve_solves():
     ros.lu_factor(factored, pivots)
     ros.lu_solve(factored, pivots, x)
     np.testing.assert_allclose(matrix @ x, b, atol=1e-12)
+
+
+@pytest.mark.parametrize("hg", [1e-9, 1e-6, 1e-3])
+def test_the_reduced_solve_solves_the_whole_iteration_matrix(hg):
+    """W = I/(hγ) − J with J's first n rows [0 I 0] (f's first n rows are q̇), stiff rows below (|J| up to 1e9, as a
+    squeeze film's): reduced_matrix + reduced_solve give W⁻¹ b, the positions eliminated."""
+    rng = np.random.default_rng(3)
+    n, ny = 4, 11
+    jacobian = np.zeros((ny, ny + 1))
+    jacobian[n:, :ny] = rng.normal(size=(ny - n, ny)) * np.logspace(0, 9, ny)
+    jacobian[:n, n:2 * n] = np.eye(n)
+    b = rng.normal(size=ny)
+    whole = np.eye(ny) / hg - jacobian[:, :ny]
+    matrix, pivots, scratch = np.empty((ny - n, ny - n)), np.zeros(ny - n, np.int64), np.empty(ny - n)
+    ros.reduced_matrix(jacobian, hg, n, matrix)
+    ros.lu_factor(matrix, pivots)
+    u = b.copy()
+    ros.reduced_solve(matrix, pivots, jacobian, hg, n, u, scratch)
+    np.testing.assert_allclose(u, np.linalg.solve(whole, b), rtol=1e-9, atol=0)

@@ -114,6 +114,8 @@ def test_petroff_torque_at_the_centre_and_its_growth_towards_the_wall():
 
 def test_range_warnings_name_the_joint_and_the_model_outside_its_length_to_diameter_ratio():
     assert lub.film_range_warnings("J", lub.SHORT_BEARING, MU, 0.05, 0.05) == []  # L/D = 0.5
+    assert lub.film_range_warnings("J", lub.SHORT_BEARING, MU, 0.05, 0.05 - 1e-5) == []  # L/D = 0.5001 prints 0.5
+    assert lub.film_range_warnings("J", lub.SHORT_BEARING, MU, 0.0501, 0.05)  # 0.501
     [text] = lub.film_range_warnings("J", lub.SHORT_BEARING, MU, 0.1, 0.05)  # L/D = 1
     assert "joint 'J'" in text and "short_bearing" in text and "L/D = 1 " in text
     assert lub.film_range_warnings("J", lub.LONG_BEARING, MU, 0.2, 0.05) == []  # L/D = 2

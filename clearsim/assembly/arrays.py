@@ -86,9 +86,11 @@ SystemArrays = namedtuple(
 # wear_harmonics[k]: M of joint k's worn profile (0: a circular bore), whose coefficients [a_0, a_1, b_1, ...] are the
 # start of the row wear_profile[k]; wear_depth_range[k] bounds its max − min (m; the nearest-point search's window).
 # wear_slots[k]: (first slot in z of its accumulated Archard profile, −1: none;
-# its harmonics M); wear_rates[k]: (WEAR_SCALE, g_0 .. g_M the kernel's weights)
+# its harmonics M); wear_rates[k]: (WEAR_SCALE, WEAR_LINE_STIFFNESS, g_0 .. g_M the kernel's weights)
 WEAR_SLOT, WEAR_SLOT_HARMONICS = 0, 1
 WEAR_SCALE = 0  # k_w / (H L R_B c): the rate of the scaled profile h/c per unit F_n |v_t| (1/(N·m))
+WEAR_LINE_STIFFNESS = 1  # S = π L E* (N/m) of the load-following band; 0: the stated width's kernel alone
+WEAR_WEIGHTS = 2  # g_0 .. g_M from here
 
 
 # --- the form the kernels take: one numba structref holding the arrays above -------------------------

@@ -15,7 +15,7 @@ from clearsim.assembly.arrays import (
     CLEARANCE_COLUMNS, CLEARANCE_LAW_COLUMNS, CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_DRY_GAP,
     CL_EXPONENT, CL_FILM_LENGTH, CL_JOURNAL_POINT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S,
     CL_RESTITUTION, CL_STIFFNESS, CL_V_HIGH, CL_V_LOW, CL_VISCOSITY, HYDRAULIC_COLUMNS, HYDRAULIC_LAW_COLUMNS,
-    LOAD_COLUMNS, SPRING_COLUMNS, TORSION_COLUMNS, WEAR_SCALE, SystemArrays,
+    LOAD_COLUMNS, SPRING_COLUMNS, TORSION_COLUMNS, WEAR_LINE_STIFFNESS, WEAR_SCALE, WEAR_WEIGHTS, SystemArrays,
 )
 from clearsim.errors import Problem
 from clearsim.model import schema
@@ -298,7 +298,7 @@ def wear_arrays(parameters: list[ClearanceParameters], first_slot: int) -> dict:
     count = len(parameters)
     profile_width = max([len(p.wear_profile) for p in parameters] + [1])
     profile = np.zeros((count, profile_width))
-    rate_width = max([p.archard.harmonics + 2 for p in parameters if p.archard] + [2])
+    rate_width = max([WEAR_WEIGHTS + p.archard.harmonics + 1 for p in parameters if p.archard] + [WEAR_WEIGHTS + 1])
     rates = np.zeros((count, rate_width))
     slots = np.full((count, 2), -1, np.int64)
     for k, p in enumerate(parameters):
@@ -308,7 +308,9 @@ def wear_arrays(parameters: list[ClearanceParameters], first_slot: int) -> dict:
             first_slot += archard_state_count(p.archard)
             rates[k, WEAR_SCALE] = p.archard.coefficient / (p.archard.hardness * p.archard.length * p.bearing_radius
                                                             * p.clearance)
-            rates[k, 1:p.archard.harmonics + 2] = wear.kernel_weights(p.archard.sigma, p.archard.harmonics)
+            rates[k, WEAR_LINE_STIFFNESS] = p.archard.line_stiffness
+            rates[k, WEAR_WEIGHTS:WEAR_WEIGHTS + p.archard.harmonics + 1] = wear.kernel_weights(p.archard.sigma,
+                                                                                             p.archard.harmonics)
     return {"wear_harmonics": np.array([(len(p.wear_profile) - 1) // 2 for p in parameters], np.int64).reshape(count),
             "wear_profile": profile, "wear_depth_range": np.array([wear.depth_range(p.wear_profile) for p in parameters]),
             "wear_slots": slots, "wear_rates": rates}

@@ -20,8 +20,8 @@ from numba import njit
 from clearsim.assembly.arrays import (
     CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_POINT,
     CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_RESTITUTION, CL_STIFFNESS,
-    CL_V_HIGH, CL_V_LOW, CL_DRY_GAP, CL_FILM_LENGTH, CL_VISCOSITY, LAW_FILM_MODEL, WEAR_SCALE, WEAR_SLOT,
-    WEAR_SLOT_HARMONICS,
+    CL_V_HIGH, CL_V_LOW, CL_DRY_GAP, CL_FILM_LENGTH, CL_VISCOSITY, LAW_FILM_MODEL, WEAR_LINE_STIFFNESS, WEAR_SCALE,
+    WEAR_SLOT, WEAR_SLOT_HARMONICS, WEAR_WEIGHTS,
 )
 from clearsim.assembly.kinematics import (
     GROUND, add_global_force, add_point_force, body_frame, body_pose, body_rates, frame_point, frame_rotate,
@@ -33,7 +33,7 @@ from clearsim.physics.contact import damped_force
 from clearsim.physics.cylindrical import law_state
 from clearsim.physics.friction import STICK_EXACT, friction_coefficient, sliding_coefficient
 from clearsim.physics.lubrication import film_force, film_torque, line_of_centres
-from clearsim.physics.wear import add_kernel_rates, closest_bore_point
+from clearsim.physics.wear import add_band_rates, band_half_angle, bore_curvature_radius, closest_bore_point
 
 # modes of a clearance joint, constant within a step. CONTACT is any contact of a smooth friction
 # law, and sliding along +t under an exact-stick law; STICK and SLIDE_BACK (sliding along −t)
@@ -208,7 +208,8 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized):
 @njit(cache=True)
 def add_wear_rates(system, q, qd, modes, impact_speeds, zdot):
     """Write the rates of the accumulated Archard profiles (scaled by c) into their slots of ż:
-    ḣ(θ) = k_w F_n |v_t| K(θ − θ_c) / (H L R_B), θ_c the contact point's angle in the bearing frame."""
+    ḣ(θ) = k_w F_n |v_t| K(θ − θ_c) / (H L R_B), θ_c the contact point's angle in the bearing frame, K the kernel
+    with the band of the contact's half-angle there (physics/wear.py)."""
     for k in range(system.wear_slots.shape[0]):
         slot = system.wear_slots[k, WEAR_SLOT]
         if slot < 0:
@@ -226,8 +227,19 @@ def add_wear_rates(system, q, qd, modes, impact_speeds, zdot):
             continue
         arm_x, arm_y = bearing_contact_arm(system, k, q, qd, kinematics)
         contact_angle = np.arctan2(arm_y, arm_x) - body_pose(q, system.clearance_bodies[k, 0])[2]
-        add_kernel_rates(rates, system.wear_rates[k, 1:], harmonics,
-                         system.wear_rates[k, WEAR_SCALE] * fn * abs(sliding), contact_angle)
+        add_band_rates(rates, system.wear_rates[k, WEAR_WEIGHTS:], harmonics,
+                       system.wear_rates[k, WEAR_SCALE] * fn * abs(sliding), contact_angle,
+                       contact_half_angle(system, k, fn, contact_angle))
+
+
+@njit(cache=True)
+def contact_half_angle(system, k, fn, contact_angle):
+    """α (rad) of clearance joint k's wear band under F_n at the bore's angle θ_c (physics/wear.band_half_angle)."""
+    p = system.clearance_params[k]
+    curvature_radius = bore_curvature_radius(system.wear_profile[k], system.wear_harmonics[k],
+                                             p[CL_BEARING_RADIUS], contact_angle)
+    return band_half_angle(fn, system.wear_rates[k, WEAR_LINE_STIFFNESS], p[CL_JOURNAL_RADIUS], curvature_radius,
+                           p[CL_BEARING_RADIUS])
 
 
 MAX_FILM_ECCENTRICITY = 1.0 - 1e-9  # ε of a trial stage beyond the wall (rejected by the step control) is capped

@@ -69,6 +69,7 @@ def wear_profile_tables(system, final_state: np.ndarray, time: float) -> dict:
             {"depth": (evaluate_profile(coefficients, angles), "m"), "angle": (angles, "rad")},
             {"coefficients_m": coefficients, "time_s": time, "wear_coefficient": archard.coefficient,
              "hardness_Pa": archard.hardness, "length_m": archard.length, "width_m": archard.width,
+             "band": "fixed width" if archard.line_stiffness == 0.0 else "load-following (Hertz line contact)",
              "harmonics": archard.harmonics, "law": "Archard: dV = k_w F_n |v_t| dt / H (docs/model-contact.md)",
              "angle_frame": "bearing body's frame, from its x axis"})
     return tables

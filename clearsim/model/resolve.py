@@ -75,6 +75,7 @@ class ArchardNumbers:
     width: float  # m, the kernel's width w = R_B/K(0) (the stated one, or the narrowest the harmonics carry)
     harmonics: int
     sigma: float  # rad, the kernel's σ
+    line_stiffness: float = 0.0  # N/m, S = π L E* of the load-following band (physics/wear.py); 0: a stated width
 
 
 def is_clearance_joint(joint) -> bool:
@@ -105,11 +106,12 @@ def resolve_clearance(joint, defaults: Defaults) -> ClearanceParameters | None:
         initial_velocity=tuple(map(float, getattr(joint, "initial_velocity", None) or (0.0, 0.0))),
         **_film_numbers(*_merged_lubrication(joint, defaults), clearance, contact.get("length")),
         **_wear_numbers(getattr(joint, "wear", None), bearing, contact.get("length"),
-                        bool(_merged_lubrication(joint, defaults)[0].get("viscosity"))),
+                        bool(_merged_lubrication(joint, defaults)[0].get("viscosity")),
+                        joint.material or defaults.material),
     )
 
 
-def _wear_numbers(spec, bearing_radius: float, pin_length: float | None, lubricated: bool) -> dict:
+def _wear_numbers(spec, bearing_radius: float, pin_length: float | None, lubricated: bool, material) -> dict:
     """The worn profile's coefficients (an all-zero profile is the circular bore) and the Archard numbers."""
     if spec is None:
         return {}
@@ -122,11 +124,15 @@ def _wear_numbers(spec, bearing_radius: float, pin_length: float | None, lubrica
         if coefficients.any():
             numbers["wear_profile"] = tuple(float(c) for c in coefficients)
     if spec.archard is not None:
-        numbers["archard"] = _archard_numbers(spec.archard, bearing_radius, pin_length)
+        numbers["archard"] = _archard_numbers(spec.archard, bearing_radius, pin_length, material)
     return numbers
 
 
-def _archard_numbers(archard, bearing_radius: float, pin_length: float | None) -> ArchardNumbers:
+def _archard_numbers(archard, bearing_radius: float, pin_length: float | None, material) -> ArchardNumbers:
+    """A stated `width` fixes the kernel; without one the band follows the load (S = π L E*) over the narrowest
+    kernel the harmonics carry."""
+    from clearsim.physics.cylindrical import effective_modulus
+
     length = archard.length if archard.length is not None else pin_length
     if length is None:
         raise ResolveError(("wear", "archard", "length"), "Archard wear needs the length L of the worn band",
@@ -137,8 +143,10 @@ def _archard_numbers(archard, bearing_radius: float, pin_length: float | None) -
         raise ResolveError(("wear", "archard", "width"), f"the wear width {_mm(width)} is not shorter than the "
                            f"bore's circumference {_mm(2.0 * math.pi * bearing_radius)}",
                            "the width is the contact's, along the bore: a fraction of it, e.g. 2 mm")
+    line_stiffness = 0.0 if archard.width else math.pi * length * effective_modulus(
+        material.youngs_modulus, material.poisson_ratio, material.youngs_modulus, material.poisson_ratio)
     return ArchardNumbers(archard.coefficient, archard.hardness, length, width, archard.harmonics,
-                          wear.kernel_sigma(width, archard.harmonics, bearing_radius))
+                          wear.kernel_sigma(width, archard.harmonics, bearing_radius), line_stiffness)
 
 
 # --- geometry -------------------------------------------------------------------------------------

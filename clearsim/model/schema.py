@@ -221,8 +221,9 @@ class ArchardWear(Strict):
     hardness: Pressure = Field(gt=0.0, description="hardness H of the worn (bearing) surface, e.g. 2 GPa")
     length: Length | None = Field(None, gt=0.0, description="axial length L of the worn band; default: the pin's "
                                   "`contact.length`")
-    width: Length | None = Field(None, gt=0.0, description="contact width w over which the depth rate is "
-                                 "k_w F_n |v_t| / (H L w); default and minimum: the narrowest `harmonics` carry")
+    width: Length | None = Field(None, gt=0.0, description="a fixed contact width w over which the depth rate is "
+                                 "k_w F_n |v_t| / (H L w), at least the narrowest `harmonics` carry; default: the "
+                                 "band follows the load (Hertz line contact, docs/model-contact.md)")
     harmonics: int = Field(64, ge=1, le=512, description="harmonics M of the accumulated profile")
 
 

@@ -10,9 +10,12 @@ normal. The journal (radius R_J, centre e in the bearing frame) touches it at th
 the contact normal n = (r(θ*) − e)/|r(θ*) − e| is the bore's local normal there (exact, not e/|e|).
 
 Archard's law gives the worn volume rate V̇ = k_w F_n |v_t| / H; it is spread over the bore with a periodic kernel
-K(φ) = (1/2π)(1 + 2 Σ g_m cos mφ), g_m = exp(−m²σ²/2) (a wrapped Gaussian truncated at M harmonics, ∫K dφ = 1):
-ḣ(θ) = V̇ K(θ − θ_c)/(L R_B), so the volume is exactly Archard's and the depth rate under the contact is
-V̇/(L w) with w = R_B/K(0) the kernel's width, σ solved from the stated width.
+K(φ) = (1/2π)(1 + 2 Σ g_m B_m cos mφ), g_m = exp(−m²σ²/2) (a wrapped Gaussian truncated at M harmonics) and B_m the
+Fourier coefficients of the contact's band, ∫K dφ = 1: ḣ(θ) = V̇ K(θ − θ_c)/(L R_B), so the volume is exactly
+Archard's and the depth rate under the contact is V̇/(L w) with w = R_B/K(0) the kernel's width. Either the band
+follows the load (the default): a half-cosine over the contact's half-angle α = b/R_B, b the Hertz line-contact
+half-width with the bore's local clearance, at most π/2 (conformal), smoothed by the narrowest Gaussian M carries
+(σ = 4/M); or a stated width fixes σ (B_m = 1).
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ from scipy.optimize import brentq
 SAFEGUARDED_ITERATIONS = 60  # Newton converges quadratically (a step below 1e-15 rad ends it); a bisection step, taken
 # when Newton would leave its bracket of 2π/(8M) either side, halves it
 SMALLEST_SIGMA = 4.0  # σ ≥ 4/M: the truncated kernel's last weight is e^{-8} = 3e-4 of the first (no ringing)
+CONFORMAL_HALF_ANGLE = 0.5 * math.pi  # rad: a journal touches its bore within 90° of the load, however conformal
 
 
 @njit(cache=True)
@@ -134,14 +138,63 @@ def _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta):
 
 @njit(cache=True)
 def add_kernel_rates(rates, weights, harmonics, scale, theta):
-    """rates += the Fourier coefficients of scale · K(φ − θ) (K the wear kernel of `weights` g_m)."""
+    """rates += the Fourier coefficients of scale · K(φ − θ) (K the wear kernel of `weights` g_m, no band)."""
+    add_band_rates(rates, weights, harmonics, scale, theta, 0.0)
+
+
+@njit(cache=True)
+def add_band_rates(rates, weights, harmonics, scale, theta, half_angle):
+    """rates += the Fourier coefficients of scale · K(φ − θ), K the wear kernel of `weights` g_m times the band of
+    `half_angle` α (band_coefficient; α = 0: the kernel alone)."""
     rates[0] += scale / (2.0 * np.pi)
     c1, s1 = np.cos(theta), np.sin(theta)
     cm, sm = 1.0, 0.0
     for m in range(1, harmonics + 1):
         cm, sm = cm * c1 - sm * s1, sm * c1 + cm * s1
-        rates[2 * m - 1] += scale * weights[m] * cm / np.pi
-        rates[2 * m] += scale * weights[m] * sm / np.pi
+        weight = scale * weights[m] * band_coefficient(m, half_angle)
+        rates[2 * m - 1] += weight * cm / np.pi
+        rates[2 * m] += weight * sm / np.pi
+
+
+@njit(cache=True)
+def band_coefficient(m, half_angle):
+    """B_m = ∫ p(φ) cos mφ dφ / ∫ p(φ) dφ of the half-cosine band p(φ) = cos(πφ/2α) on |φ| ≤ α (0 outside):
+    cos(mα)/(1 − (2mα/π)²), written as (π/4) sinc(u)/(1 + u/π) with u = mα − π/2, which has no 0/0 at mα = π/2
+    (B_m = π/4 there). α = 0 (no band): 1."""
+    if half_angle == 0.0:
+        return 1.0
+    u = m * half_angle - 0.5 * math.pi
+    sinc = math.sin(u) / u if u != 0.0 else 1.0
+    return 0.25 * math.pi * sinc / (1.0 + u / math.pi)
+
+
+@njit(cache=True)
+def bore_curvature_radius(coefficients, harmonics, bearing_radius, theta):
+    """The radius of curvature (m) of the bore r(θ) = (R_B + h) u(θ) at θ: (ρ² + ρ'²)^{3/2}/(ρ² + 2ρ'² − ρρ''),
+    ρ = R_B + h; inf where the bore is straight or bulges inwards (denominator ≤ 0)."""
+    h, slope, curvature = profile_value(coefficients, harmonics, theta)
+    rho = bearing_radius + h
+    bending = rho * rho + 2.0 * slope * slope - rho * curvature
+    if bending <= 0.0:
+        return math.inf
+    return (rho * rho + slope * slope) ** 1.5 / bending
+
+
+@njit(cache=True)
+def band_half_angle(force, line_stiffness, journal_radius, curvature_radius, bearing_radius):
+    """α (rad) of the contact's band: b/R_B with the Hertz line contact's half-width b = √(4 F R*/S) (Johnson 1985,
+    §4.2, eq. 4.43: b² = 4 P R/(π E*), P = F/L), S = π L E* (N/m), 1/R* = 1/R_J − 1/ρ_c for the journal in the bore of
+    local radius of curvature ρ_c (its local clearance ρ_c − R_J); at most CONFORMAL_HALF_ANGLE, which it is where the
+    bore is as tight as the journal or tighter. S = 0 (a stated width): 0."""
+    if line_stiffness == 0.0:
+        return 0.0
+    local_clearance = curvature_radius - journal_radius
+    if local_clearance <= 0.0:
+        return CONFORMAL_HALF_ANGLE
+    relative_radius = journal_radius * curvature_radius / local_clearance if math.isfinite(curvature_radius) \
+        else journal_radius
+    half_width = math.sqrt(4.0 * force * relative_radius / line_stiffness)
+    return min(half_width / bearing_radius, CONFORMAL_HALF_ANGLE)
 
 
 # --- set-up (Python) ------------------------------------------------------------------------------

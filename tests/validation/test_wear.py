@@ -98,6 +98,32 @@ def test_archard_depth_under_a_steady_load_grows_as_the_closed_form(simulate):
     assert depth[np.argmin(np.abs(angles - 0.5 * math.pi))] < 1e-3 * depth[loaded]  # nothing worn opposite
 
 
+@pytest.mark.parametrize("harmonics", [16, 512])
+def test_archard_depth_under_a_steady_load_follows_its_contact_width(simulate, harmonics):
+    """Without a stated width the band follows the load: a half-cosine over the Hertz line contact's half-angle
+    α = b/R_B, b = √(4 F R_J R_B/(c π L E*)) (1.49 mm here), smoothed by the narrowest Gaussian (σ = 4/M). The depth
+    at the loaded angle is k_w F ω R_J t/(H L w) with w = R_B/K(0) of that kernel, written out here from its
+    definition; the volume k_w F ω R_J t/H whatever the width (both 1e-6)."""
+    k_w, hardness, length, omega = 1e-4, 2e9, 0.02, 100.0
+    result = simulate(loaded_pin(f"{{archard: {{coefficient: {k_w}, hardness: {hardness} Pa, length: {length} m, "
+                                 f"harmonics: {harmonics}}}}}"))
+    t = result["time"]
+    assert np.all(result["joints/J/mode"][1:] == 2)
+    modulus = 207e9 / (2 * (1 - 0.3**2))  # E* of the default steel
+    half_width = math.sqrt(4 * FORCE * JOURNAL_RADIUS * BEARING_RADIUS / (CLEARANCE * math.pi * length * modulus))
+    alpha, sigma, m = half_width / BEARING_RADIUS, 4 / harmonics, np.arange(1, harmonics + 1)
+    band = np.cos(m * alpha) / (1 - (2 * m * alpha / math.pi) ** 2)  # ∫cos(πφ/2α) cos mφ dφ / ∫cos(πφ/2α) dφ
+    peak = (1 + 2 * np.sum(np.exp(-0.5 * (m * sigma) ** 2) * band)) / (2 * math.pi)
+    width = BEARING_RADIUS / peak
+    volume_rate = k_w * FORCE * omega * JOURNAL_RADIUS / hardness
+    assert result["joints/J/wear/volume"] == pytest.approx(volume_rate * t, rel=1e-6, abs=1e-30)
+    assert result["joints/J/wear/max_depth"] == pytest.approx(volume_rate * t / (length * width), rel=1e-6, abs=1e-30)
+    angles, depth = result["joints/J/wear/angle"], result["joints/J/wear/depth"]
+    assert np.argmax(depth) == np.argmin(np.abs(angles - 1.5 * math.pi))
+    if harmonics == 512:  # the band, not the kernel, sets the width: near the half-cosine's 4b/π
+        assert width == pytest.approx(4 * half_width / math.pi, rel=0.05)
+
+
 def test_a_bearing_turning_under_a_steady_load_wears_evenly_in_its_own_frame(simulate):
     """The bearing turns once at ω under the pin (pressed down by F, not turning): the contact sweeps the whole bore
     in the bearing's frame, so after the turn the profile is even, k_w F ω R_B t/(2π R_B L H) deep (1e-6)."""

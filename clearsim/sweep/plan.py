@@ -20,7 +20,7 @@ from clearsim.model.resolve import is_clearance_joint
 from clearsim.sweep import grid, montecarlo
 from clearsim.sweep.grid import Case, SweepOptionError
 
-KEEP = ("all", "summary")  # what `--keep` may ask each case's file to hold (runner.CONTENTS)
+KEEP = ("all", "summary", "figures")  # what `--keep` may ask each case's file to hold (runner.CONTENTS)
 
 RESULTS = Path("results")
 MAX_CASES = 100_000  # each case is loaded and checked before anything runs (~3 ms each): 5 minutes of planning
@@ -42,7 +42,7 @@ class SweepRequest:
     ideal: bool = True
     out: Path | None = None
     delay_fraction: float = 0.5
-    keep: str = "all"  # the histories each case's file holds: "all", or "summary" (KEEP)
+    keep: str = "all"  # the histories each case's file holds: "all", "summary" or "figures" (KEEP)
 
 
 @dataclass
@@ -89,9 +89,10 @@ def _check_request(request: SweepRequest) -> None:
     if request.seed < 0:
         raise SweepOptionError(f"--seed must be 0 or more, got {request.seed}")
     if request.keep not in KEEP:
-        raise SweepOptionError(f"--keep must be {' or '.join(KEEP)}, got '{request.keep}'\n  hint: all (the default) "
-                               "keeps every history; summary leaves out the bodies' motion and the ideal joints' "
-                               "reactions (docs/sweeps.md §2)")
+        raise SweepOptionError(f"--keep must be {', '.join(KEEP[:-1])} or {KEEP[-1]}, got '{request.keep}'\n  hint: "
+                               "all (the default) keeps every history; summary leaves out the bodies' motion and the "
+                               "ideal joints' reactions; figures keeps only what summary.csv reads: the sensors and "
+                               "the clearance joints' normal force, mode and stick flag (docs/sweeps.md §2)")
 
 
 def _grid(request: SweepRequest, mechanism, fixed, swept) -> tuple[list[Case], list[str]]:

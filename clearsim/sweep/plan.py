@@ -56,9 +56,13 @@ class SweepPlan:
     delay_fraction: float
     sampled: bool = False
     keep: str = "all"
+    _by_name: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def case(self, name: str) -> Case:
-        return next(c for c in self.cases if c.name == name)
+        """The case of that name, by a lookup (the summary asks for each of up to MAX_CASES cases)."""
+        if len(self._by_name) != len(self.cases):
+            self._by_name = {c.name: c for c in self.cases}
+        return self._by_name[name]
 
 
 class SweepInputError(ClearsimError):

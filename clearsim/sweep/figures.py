@@ -1,7 +1,8 @@
 """Figures of merit of a case, read against its ideal reference (definitions: docs/sweeps.md).
 
 `read_record` runs where the case ran (a pool or Dask worker) and keeps only what the summary
-needs; the figures that compare with the ideal case are computed once all records are in.
+needs; the figures that compare with the ideal case are taken as soon as both records are in (`settled`), and
+the case's histories dropped then.
 """
 
 from __future__ import annotations

@@ -271,8 +271,9 @@ def sweep(
         0.5, "--delay-fraction", help="Start delay: when the output velocity reaches this fraction of the ideal peak."),
     retry_failed: bool = typer.Option(False, "--retry-failed", help="Run cases that failed before again."),
     keep: str = typer.Option(
-        "all", "--keep", help="What each case's file holds: all, or summary (the sensors, the clearance joints, the "
-        "energies: what the summary and `clearsim plot` read; a UHV case ~3× smaller, for Monte Carlo studies)."),
+        "all", "--keep", help="What each case's file holds: all; summary (the sensors, the clearance joints, the "
+        "energies: what the summary and `clearsim plot` read; a UHV case ~3× smaller); or figures (what summary.csv "
+        "reads alone, for Monte Carlo studies)."),
 ) -> None:
     """Run a parameter study: one run per case, in parallel, with a summary table and summary.csv."""
     from clearsim.runner import BUNDLED_CONFIG

@@ -49,10 +49,13 @@ BUNDLED_CONFIG = Path(__file__).parent / "configs" / "uhv_breaker.yaml"
 # which per-sample histories a result file holds (its `contents` attribute, absent for "all"), each a subset of the
 # one before: every dataset of the result layout (README); "summary", all but the bodies' q, q̇, q̈ and the ideal joints' reactions
 # — what a sweep's summary table and `clearsim plot`'s figures read (`clearsim sweep --keep summary`; a UHV case at
-# 100 kHz 4.4 → 1.3 MB); or the sensors alone — a diagnosis reads nothing else of its model runs (0.31 MB). The
-# contact modes' episode tables and the run's attributes are in every file.
+# 100 kHz 4.4 → 1.3 MB); "figures", the sensors and the clearance joints' normal force, mode and stick flag — what
+# the sweep's figures of merit read (`summarize`; `--keep figures`, for Monte Carlo studies); or the sensors alone — a
+# diagnosis reads nothing else of its model runs (0.31 MB). The contact modes' episode tables and the run's
+# attributes are in every file.
 CONTENTS = {"all": lambda name: True,
             "summary": lambda name: not name.startswith("bodies/") and not name.endswith("/reaction"),
+            "figures": lambda name: summary_dataset(name),
             "sensors": lambda name: name.startswith("sensors/")}
 
 

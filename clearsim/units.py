@@ -139,6 +139,14 @@ def parse_quantity(value: Any):
         return registry().Quantity(_check_finite(value, value))
     if not isinstance(value, str):
         raise UnitError(f"expected a number or a 'value unit' string, got {value!r}")
+    return _quantity_of_text(value)
+
+
+@lru_cache(maxsize=4096)
+def _quantity_of_text(value: str):
+    """parse_quantity of a text, kept: a mechanism names the same few dozen quantities in every load (a sweep loads it
+    once per case, where pint's parsing took 60 % of the time); a quantity of a float magnitude is not changed in
+    place, so one object serves every caller. A text that fails is parsed again (and fails again) each time."""
     pint = _import_pint()
     _number_first(value)
     _one_number(value)

@@ -24,7 +24,6 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy.optimize import brentq
 
 SAFEGUARDED_ITERATIONS = 60  # Newton converges quadratically (a step below 1e-15 rad ends it); a bisection step, taken
 # when Newton would leave its bracket of 2π/(8M) either side, halves it
@@ -270,4 +269,6 @@ def kernel_sigma(width: float, harmonics: int, radius: float) -> float:
     high = low
     while kernel_width(high, harmonics, radius) < width and high < 1e3:  # w → 2πR as σ → ∞
         high *= 2.0
+    from scipy.optimize import brentq  # here: importing scipy.optimize takes 36 MB, in every sweep worker
+
     return brentq(lambda s: kernel_width(s, harmonics, radius) - width, low, high, xtol=1e-300, rtol=1e-15)

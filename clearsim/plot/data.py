@@ -86,6 +86,8 @@ class RunData:
 # what a file with fewer histories than the full layout holds (its `contents` attribute, runner.CONTENTS)
 REDUCED_CONTENTS = {
     "summary": "the histories a sweep keeps with --keep summary (no bodies' motion, no ideal joints' reactions)",
+    "figures": "the histories a sweep keeps with --keep figures (the sensors, the clearance joints' normal force, "
+               "mode and stick flag)",
     "sensors": "the time and the sensors alone (a diagnosis's model run)",
 }
 

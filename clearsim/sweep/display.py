@@ -149,8 +149,12 @@ def percentile_table(entries: list[dict]) -> WholeCellTable:
     return WholeCellTable(keys, columns)
 
 
+KEPT = {"all": "", "summary": " (each file: the summary histories)",
+        "figures": " (each file: the histories the figures of merit read)"}
+
+
 def opening_line(plan: SweepPlan, where: str) -> str:
-    kept = "" if plan.keep == "all" else f" (each file: the {plan.keep} histories)"
+    kept = KEPT[plan.keep]
     return f"sweep of {len(plan.cases)} cases of {plan.config.name} on {where} → {plan.folder}{kept}"
 
 

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable
 
 from clearsim.errors import ClearsimError
+from clearsim.sweep.figures import settled
 from clearsim.sweep.plan import SweepPlan, check_folder, write_cases
 from clearsim.sweep.summary import (PERCENTILES_FILE, SUMMARY_FILE, percentile_header, percentiles,
                                     summary_rows, write_csv)
@@ -61,9 +62,11 @@ def run_sweep(plan: SweepPlan, executor, progress: Progress | None = None,
     write_cases(plan)
     outcomes: dict[str, CaseOutcome] = {}
     tasks = tasks_of(plan, retry_failed)
+    waiting = dependents(plan)
 
     def collect(outcome: CaseOutcome) -> None:
         outcomes[outcome.name] = outcome
+        outcomes.update(settle(plan, outcomes, outcome.name, waiting))
         if progress is not None:
             progress(outcome, len(outcomes), len(tasks))
 
@@ -78,6 +81,34 @@ def run_sweep(plan: SweepPlan, executor, progress: Progress | None = None,
     if interrupted:
         raise SweepInterrupted(result)
     return result
+
+
+def dependents(plan: SweepPlan) -> dict[str, list[str]]:
+    """Ideal case → the cases read against it."""
+    found: dict[str, list[str]] = {}
+    for case in plan.cases:
+        if case.reference:
+            found.setdefault(case.reference, []).append(case.name)
+    return found
+
+
+def settle(plan: SweepPlan, outcomes: dict[str, CaseOutcome], name: str,
+           waiting: dict[str, list[str]]) -> dict[str, CaseOutcome]:
+    """The outcomes that can drop their histories now that `name` is in (figures.settled): that case once its
+    reference (its ideal case) has completed, or at once without one; when it is an ideal case, the cases in
+    `waiting` for it (`dependents`). An ideal case keeps its own (the others are read against them), and so does a
+    case whose ideal case did not complete (after Ctrl-C its finished file may still be read back, `recovered`)."""
+    names = [name, *(n for n in waiting.get(name, ()) if n in outcomes)]
+    changed = {}
+    for case in (plan.case(n) for n in names):
+        record = outcomes[case.name].record
+        reference = outcomes.get(case.reference) if case.reference else None
+        ideal = reference.record if reference is not None else None
+        if case.ideal or record is None or record.relative is not None:
+            continue
+        if case.reference is None or (ideal is not None and ideal.complete):
+            changed[case.name] = replace(outcomes[case.name], record=settled(record, ideal, plan.delay_fraction))
+    return changed
 
 
 def recovered(tasks: list[CaseTask], outcomes: dict[str, CaseOutcome]) -> dict[str, CaseOutcome]:

@@ -20,7 +20,7 @@ from clearsim.model.resolve import is_clearance_joint
 from clearsim.sweep import grid, montecarlo
 from clearsim.sweep.grid import Case, SweepOptionError
 
-KEEP = ("all", "summary")  # what `--keep` may ask each case's file to hold (runner.CONTENTS)
+KEEP = ("all", "summary", "figures")  # what `--keep` may ask each case's file to hold (runner.CONTENTS)
 
 RESULTS = Path("results")
 MAX_CASES = 100_000  # each case is loaded and checked before anything runs (~3 ms each): 5 minutes of planning
@@ -42,7 +42,7 @@ class SweepRequest:
     ideal: bool = True
     out: Path | None = None
     delay_fraction: float = 0.5
-    keep: str = "all"  # the histories each case's file holds: "all", or "summary" (KEEP)
+    keep: str = "all"  # the histories each case's file holds: "all", "summary" or "figures" (KEEP)
 
 
 @dataclass
@@ -56,9 +56,13 @@ class SweepPlan:
     delay_fraction: float
     sampled: bool = False
     keep: str = "all"
+    _by_name: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def case(self, name: str) -> Case:
-        return next(c for c in self.cases if c.name == name)
+        """The case of that name, by a lookup (the summary asks for each of up to MAX_CASES cases)."""
+        if len(self._by_name) != len(self.cases):
+            self._by_name = {c.name: c for c in self.cases}
+        return self._by_name[name]
 
 
 class SweepInputError(ClearsimError):
@@ -89,9 +93,10 @@ def _check_request(request: SweepRequest) -> None:
     if request.seed < 0:
         raise SweepOptionError(f"--seed must be 0 or more, got {request.seed}")
     if request.keep not in KEEP:
-        raise SweepOptionError(f"--keep must be {' or '.join(KEEP)}, got '{request.keep}'\n  hint: all (the default) "
-                               "keeps every history; summary leaves out the bodies' motion and the ideal joints' "
-                               "reactions (docs/sweeps.md §2)")
+        raise SweepOptionError(f"--keep must be {', '.join(KEEP[:-1])} or {KEEP[-1]}, got '{request.keep}'\n  hint: "
+                               "all (the default) keeps every history; summary leaves out the bodies' motion and the "
+                               "ideal joints' reactions; figures keeps only what summary.csv reads: the sensors and "
+                               "the clearance joints' normal force, mode and stick flag (docs/sweeps.md §2)")
 
 
 def _grid(request: SweepRequest, mechanism, fixed, swept) -> tuple[list[Case], list[str]]:

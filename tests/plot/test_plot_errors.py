@@ -42,6 +42,18 @@ def test_a_diagnosis_run_file_holding_the_sensors_alone_is_named_as_such(runs, t
     assert "run its mechanism with `clearsim run` for every history" in message
 
 
+def test_a_sweep_figures_file_is_named_as_such(runs, tmp_path):
+    """A `--keep figures` case file holds what summary.csv reads, not what the joint figures draw."""
+    reduced = shutil.copy(runs["clearance"], tmp_path / "case.h5")
+    with h5py.File(reduced, "r+") as handle:  # as `clearsim sweep --keep figures` writes its cases
+        handle.attrs["contents"] = "figures"
+        for group in ("bodies", "energy", "constraints"):
+            del handle[group]
+        del handle["joints/slider_pin/eccentricity"]
+    message = fails(tmp_path, reduced)
+    assert "case.h5: holds the histories a sweep keeps with --keep figures" in message
+
+
 def test_a_sweep_summary_file_plots_its_figures_and_names_itself_for_the_animation(runs, tmp_path):
     """A `--keep summary` case file has what the standard figures read; the animation needs the bodies' poses, and
     the message says which kind of file this is instead of calling it interrupted."""

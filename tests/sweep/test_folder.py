@@ -102,6 +102,21 @@ def test_a_summary_file_serves_a_summary_or_diagnosis_case_not_a_full_one(tmp_pa
     assert not summary.exists() and (tmp_path / "summary.previous.h5").exists()
 
 
+def test_a_figures_file_serves_a_figures_or_diagnosis_case_and_is_served_by_a_summary_or_full_file(tmp_path):
+    """`--keep figures` files (what summary.csv reads) are resumed by a `--keep figures` sweep and serve a diagnosis;
+    a summary or full file serves a figures case; a figures file does not serve a summary case (kept aside)."""
+    assert _reusable(_result(tmp_path / "full.h5", "text"), "text", retry_failed=False, contents="figures")
+    assert _reusable(_result(tmp_path / "summary.h5", "text", contents="summary"), "text", retry_failed=False,
+                     contents="figures")
+    figures = _result(tmp_path / "figures.h5", "text", contents="figures")
+    assert _reusable(figures, "text", retry_failed=False, contents="figures")
+    assert _reusable(figures, "text", retry_failed=False, contents="sensors")
+    assert not _reusable(_result(tmp_path / "sensors.h5", "text", contents="sensors"), "text", retry_failed=False,
+                         contents="figures")
+    assert not _reusable(figures, "text", retry_failed=False, contents="summary")
+    assert not figures.exists() and (tmp_path / "figures.previous.h5").exists()
+
+
 def test_a_result_of_another_yaml_is_kept_with_a_number_beside_the_earlier_kept_one(tmp_path):
     output = _result(tmp_path / "case.h5", "second")
     oldest = _result(tmp_path / "case.previous.h5", "first")

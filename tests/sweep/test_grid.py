@@ -190,7 +190,7 @@ def test_a_tolerance_whose_value_does_not_fit_its_path_is_reported_at_the_tolera
     (["--clearance", "0.1", "--workers", "100000"], "error: --workers 100000: this machine gives clearsim "),  # was: run
     (["--clearance", "0.1", "--delay-fraction", "1.5"], "error: --delay-fraction must be between 0 and 1, got 1.5"),
     (["--sample", "3", "--seed", "-1"], "error: --seed must be 0 or more, got -1"),
-    (["--clearance", "0.1", "--keep", "bodies"], "error: --keep must be all or summary, got 'bodies'"),
+    (["--clearance", "0.1", "--keep", "bodies"], "error: --keep must be all, summary or figures, got 'bodies'"),
 ])
 def test_bad_options_exit_2_with_one_clear_message_and_write_nothing(tmp_path, options, message):
     out = tmp_path / "sweep"

@@ -5,12 +5,14 @@ import csv
 import shutil
 from pathlib import Path
 
+import h5py
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
 from clearsim.cli import app
 from clearsim.io.hdf5 import read_attributes
-from clearsim.runner import summarize
+from clearsim.runner import summarize, summary_dataset
 from clearsim.sweep import LocalPool, SweepRequest, plan_sweep, run_sweep
 
 CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
@@ -109,18 +111,24 @@ def test_a_rerun_runs_only_the_missing_case(pool_sweep, tmp_path):
     assert not list(out.glob("*.previous*.h5"))
 
 
+def kept_sweep(full: Path, tmp_path: Path, keep: str, announced: str) -> Path:
+    """The sweep of the full one with `--keep keep`: announced as such, with the full sweep's summary numbers, each
+    file flagged with what it holds."""
+    out = tmp_path / keep
+    result = invoke("sweep", SLIDER_CRANK, "--set", SHORT, "--clearance", CLEARANCES, "--workers", 2, "-o", out,
+                    "--keep", keep)
+    assert result.exit_code == 0, result.output
+    assert announced in result.output
+    assert {c: numbers(r) for c, r in read_summary(out).items()} == {c: numbers(r) for c, r in read_summary(full).items()}
+    assert all(read_attributes(out / f"{case}.h5")["contents"] == keep for case in CASES)
+    return out
+
+
 def test_keep_summary_gives_the_same_summary_from_smaller_files_and_reuse_follows_what_they_hold(pool_sweep, tmp_path):
     """`--keep summary`: the summary numbers of the full sweep, each file flagged and smaller; a full folder serves
     a `--keep summary` sweep as it is, a summary folder does not serve a full sweep (its files are kept aside)."""
-    out = tmp_path / "summary"
-    result = invoke("sweep", SLIDER_CRANK, "--set", SHORT, "--clearance", CLEARANCES, "--workers", 2, "-o", out,
-                    "--keep", "summary")
-    assert result.exit_code == 0, result.output
-    assert "(each file: the summary histories)" in result.output
-    full = read_summary(pool_sweep[0])
-    assert {c: numbers(r) for c, r in read_summary(out).items()} == {c: numbers(r) for c, r in full.items()}
+    out = kept_sweep(pool_sweep[0], tmp_path, "summary", "(each file: the summary histories)")
     for case in CASES:
-        assert read_attributes(out / f"{case}.h5")["contents"] == "summary"
         assert (out / f"{case}.h5").stat().st_size < 0.6 * (pool_sweep[0] / f"{case}.h5").stat().st_size
     served = tmp_path / "served"
     shutil.copytree(pool_sweep[0], served)
@@ -131,6 +139,30 @@ def test_keep_summary_gives_the_same_summary_from_smaller_files_and_reuse_follow
     assert sorted(everything.ran) == sorted(CASES)
     assert sorted(p.name for p in out.glob("*.previous.h5")) == sorted(f"{c}.previous.h5" for c in CASES)
     assert all("contents" not in read_attributes(out / f"{case}.h5") for case in CASES)
+
+
+def test_keep_figures_gives_the_same_summary_from_files_of_the_figures_datasets_alone(pool_sweep, tmp_path):
+    """`--keep figures`: the summary numbers of the full sweep from files that hold the time, the sensors and the
+    clearance joints' normal force, mode and stick flag, bit for bit as the full file has them; such a file does not
+    serve a `--keep summary` sweep (kept aside, the case runs again)."""
+    out = kept_sweep(pool_sweep[0], tmp_path, "figures", "(each file: the histories the figures of merit read)")
+    for case in CASES:
+        with h5py.File(out / f"{case}.h5", "r") as reduced, h5py.File(pool_sweep[0] / f"{case}.h5", "r") as whole:
+            histories = [name for name, item in _datasets(reduced) if "/episodes/" not in name]
+            assert histories and all(name == "time" or summary_dataset(name) for name in histories)
+            assert {name for name, _ in _datasets(whole) if summary_dataset(name)} <= set(histories)
+            assert all(np.array_equal(reduced[name][()], whole[name][()]) for name in histories)
+        assert (out / f"{case}.h5").stat().st_size < 0.5 * (pool_sweep[0] / f"{case}.h5").stat().st_size
+    again = run_sweep(plan_sweep(SweepRequest(SLIDER_CRANK, [SHORT], CLEARANCES, out=out, keep="summary"),
+                                 SLIDER_CRANK), LocalPool(2))
+    assert sorted(again.ran) == sorted(CASES)
+    assert all(read_attributes(out / f"{case}.previous.h5")["contents"] == "figures" for case in CASES)
+
+
+def _datasets(handle) -> list:
+    found = []
+    handle.visititems(lambda name, item: found.append((name, item)) if isinstance(item, h5py.Dataset) else None)
+    return found
 
 
 def test_a_failing_case_is_recorded_and_the_others_finish(tmp_path):

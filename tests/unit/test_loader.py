@@ -88,6 +88,18 @@ def test_resolved_yaml_reproduces_the_mechanism():
     assert list(yaml.safe_load(loaded.resolved_yaml))[:3] == ["name", "defaults", "points"]  # file order kept
 
 
+def test_loads_of_one_text_with_different_overrides_do_not_share_their_document_or_source_map():
+    """A text is parsed once and each load gets its own copy: an override of one load is in no other."""
+    changed = load_mechanism_text(SLIDER_CRANK, "sc.yaml", overrides=["joints.A.clearance=0.2mm", "bodies.rod.mass=1kg"])
+    plain = load_mechanism_text(SLIDER_CRANK, "sc.yaml")
+    assert changed.mechanism.joint("A").clearance == pytest.approx(2e-4) and changed.mechanism.body("rod").mass == 1.0
+    assert plain.mechanism.joint("A").clearance == pytest.approx(1e-4) and plain.mechanism.body("rod").mass != 1.0
+    assert plain.document is not changed.document and plain.source.overrides == {}
+    assert changed.source.overrides and changed.source.positions == plain.source.positions
+    plain.document["joints"][1]["clearance"] = "0.3 mm"  # what a caller does to its document stays its own
+    assert load_mechanism_text(SLIDER_CRANK, "sc.yaml").mechanism.joint("A").clearance == pytest.approx(1e-4)
+
+
 def test_file_path_and_base_dir(tmp_path):
     config = tmp_path / "sc.yaml"
     config.write_text(SLIDER_CRANK)

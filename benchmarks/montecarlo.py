@@ -1,0 +1,123 @@
+"""Monte Carlo throughput: a UHV tolerance study (`clearsim sweep --sample N`) on the local pool.
+
+    python -m benchmarks.montecarlo --samples 200 --keep figures --json benchmarks/results/montecarlo.json
+
+Measured in one run: the planning (every case loaded and checked), the sweep's wall time and cases per minute, the
+integration time of its cases (the `wall_time_s` column), the overhead (what the wall time has beyond the
+integration shared by the workers), the disk per case, the peak resident memory of each worker process (VmHWM), and a
+single `clearsim run` of the bundled model in a fresh process beside it (its total and integration wall time), so
+that the ratios hold on a machine whose speed varies.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+UHV = ROOT / "clearsim" / "configs" / "uhv_breaker.yaml"
+TOLERANCES = """
+tolerances:
+  - {path: joints.A.clearance, distribution: uniform, low: 0.01 mm, high: 0.05 mm}
+  - {path: joints.J.clearance, distribution: uniform, low: 0.01 mm, high: 0.05 mm}
+"""
+SINGLE_RUN = """
+import sys, time
+started = time.perf_counter()
+from clearsim.runner import simulate_config
+report = simulate_config(sys.argv[1], ["joints.A.clearance=0.03mm", "joints.J.clearance=0.03mm"], sys.argv[2])
+print(time.perf_counter() - started, report.statistics.wall_time)
+"""
+
+
+def toleranced_config(folder: Path) -> Path:
+    """The bundled UHV model with its A and J clearances drawn between 0.01 and 0.05 mm (beside it: no CSV tables)."""
+    path = folder / "uhv_tolerances.yaml"
+    path.write_text(UHV.read_text(encoding="utf-8") + TOLERANCES, encoding="utf-8")
+    return path
+
+
+def peak_memory_mb(pid: int) -> float | None:
+    """VmHWM of a live process (Linux); None elsewhere or when it has ended."""
+    try:
+        with open(f"/proc/{pid}/status") as status:
+            return next(int(line.split()[1]) for line in status if line.startswith("VmHWM:")) / 1024.0
+    except (OSError, StopIteration):
+        return None
+
+
+def single_run(folder: Path) -> tuple[float, float]:
+    """(total, integration) seconds of one `clearsim run` of the UHV model at 0.03 mm in A and J, a fresh process."""
+    done = subprocess.run([sys.executable, "-c", SINGLE_RUN, str(UHV), str(folder / "single.h5")],
+                          capture_output=True, text=True, check=True, cwd=ROOT)
+    total, integration = map(float, done.stdout.split()[-2:])
+    return total, integration
+
+
+def monte_carlo(samples: int, workers: int, keep: str, folder: Path, seed: int = 1) -> dict:
+    from clearsim.runner import BUNDLED_CONFIG
+    from clearsim.sweep import LocalPool, SweepRequest, plan_sweep, run_sweep
+
+    config = toleranced_config(folder)
+    started = time.perf_counter()
+    plan = plan_sweep(SweepRequest(config, sample=samples, seed=seed, keep=keep, out=folder / "sweep"), BUNDLED_CONFIG)
+    planned = time.perf_counter()
+    with LocalPool(workers) as pool:
+        result = run_sweep(plan, pool)
+        memory = [peak_memory_mb(pid) for pid in list(pool._pool.executor._processes or {})]
+    finished = time.perf_counter()
+    with (plan.folder / "summary.csv").open(newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    integration = [float(row["wall_time_s"]) for row in rows if row["wall_time_s"]]
+    files = [path.stat().st_size for path in plan.folder.iterdir() if path.suffix == ".h5"]
+    on_disk = sum(path.stat().st_size for path in plan.folder.iterdir())
+    cases, sweep_s = len(plan.cases), finished - planned
+    return {"samples": samples, "cases": cases, "workers": workers, "keep": keep, "seed": seed,
+            "complete": result.count("complete"), "plan_s": planned - started, "sweep_s": sweep_s,
+            "cases_per_minute": 60.0 * cases / sweep_s, "cases_per_minute_with_plan": 60.0 * cases / (finished - started),
+            "integration_total_s": sum(integration), "integration_median_s": statistics.median(integration),
+            "integration_bound_cases_per_minute": 60.0 * workers * len(integration) / sum(integration),
+            "overhead_share": 1.0 - sum(integration) / workers / sweep_s,
+            "mb_per_case_file": statistics.mean(files) / 1e6 if files else 0.0,
+            "mb_per_case_on_disk": on_disk / 1e6 / cases,
+            "worker_peak_rss_mb": [m for m in memory if m is not None]}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.montecarlo", description=__doc__.splitlines()[0])
+    parser.add_argument("--samples", type=int, default=200)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--keep", default="figures", help="all, summary or figures (clearsim sweep --keep)")
+    parser.add_argument("--json", type=Path, help="write the result here (e.g. benchmarks/results/montecarlo.json)")
+    options = parser.parse_args(argv)
+    folder = Path(tempfile.mkdtemp(prefix="clearsim-montecarlo-"))
+    try:
+        single_run(folder)  # the kernels loaded once into the cache before anything is timed
+        result = monte_carlo(options.samples, options.workers, options.keep, folder)
+        single_total, single_integration = single_run(folder)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    result |= {"single_run_s": single_total, "single_run_integration_s": single_integration,
+               "sweep_s_per_case_and_worker_over_single_run": result["sweep_s"] * result["workers"]
+               / result["cases"] / single_total}
+    document = {"machine": {"python": platform.python_version(), "cores": len(os.sched_getaffinity(0)),
+                            "load_average": os.getloadavg()}, "montecarlo": result}
+    text = json.dumps(document, indent=2)
+    if options.json is not None:
+        options.json.write_text(text + "\n", encoding="utf-8")
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -66,6 +66,24 @@ def test_halving_the_blocks_error_changes_the_life_by_less_than_the_tolerance(pi
     assert fine.complete
 
 
+def test_with_the_load_following_band_halving_the_blocks_error_changes_the_life_by_less_than_the_tolerance(tmp_path):
+    """The default wear band (no `width`: the Hertz line contact's, narrowing as the load and the groove change it)
+    over 1 000 operations: 2 blocks at the default tolerance, 4 at a quarter of it, the clearances within 2 % of c."""
+    wear = f"{{archard: {{coefficient: {K_W}, hardness: {HARDNESS} Pa, length: {LENGTH} m}}}}"
+    config = tmp_path / "band.yaml"
+    config.write_text(loaded_pin(wear, t_end=f"{DURATION * 1e3} ms"))
+    clearances = []
+    for name, tolerance in (("coarse", 0.02), ("fine", 0.005)):
+        report = run_life(LifeRequest(config, 1000, tmp_path / f"{name}.h5", tolerance=tolerance))
+        assert report.complete
+        with h5py.File(tmp_path / f"{name}.h5", "r") as life:
+            clearances.append(life["joints/J/clearance"][()])
+    coarse, fine = clearances
+    assert len(fine) > len(coarse)  # the tighter tolerance took more blocks
+    assert coarse[-1] - CLEARANCE > 0.01 * CLEARANCE  # it wore, by more than the tolerance's resolution
+    assert abs(coarse[-1] - fine[-1]) < 0.02 * CLEARANCE, (coarse[-1], fine[-1])
+
+
 def test_a_life_continues_from_its_file(pin_config, tmp_path):
     path = tmp_path / "life.h5"
     first = run_life(LifeRequest(pin_config, 2500, path))

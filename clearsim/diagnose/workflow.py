@@ -509,9 +509,9 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
         winner = None
     if winner is not None and reaches_no_change(winner):
         say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) but its interval "
-            f"({winner.candidate.shown(winner.interval[0])}–{winner.candidate.shown(winner.interval[1])}) holds "
-            f"{winner.candidate.shown(no_change(winner.candidate))}, no change: its runs scatter as much as it improves, "
-            "one lucky run, not a missing effect")
+            f"({winner.candidate.shown(winner.interval[0])}–{winner.candidate.shown(winner.interval[1])}) reaches "
+            f"{winner.candidate.shown(no_change(winner.candidate))}, none of it: its runs scatter as much as it "
+            "improves, one lucky run, not a missing effect")
         winner = None
     if winner is not None:
         mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})

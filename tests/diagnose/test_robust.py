@@ -61,8 +61,10 @@ def test_a_needle_among_scattered_runs_reaches_no_change_and_a_basin_does_not():
     assert needle.delta_bic < -10.0 and basin.delta_bic < -10.0  # both pass the BIC on their lowest run
     assert reaches_no_change(needle), needle.interval
     assert not reaches_no_change(basin), basin.interval
-    clearance = Candidate("clearance", "pin", "clearance", "m", 2e-6, 0.5e-3, True, 1e-4, lambda doc, value: None)
-    assert no_change(clearance) == 1e-4  # a present value: changing nothing is keeping it
+    present = Candidate("clearance", "pin", "clearance", "m", 2e-6, 0.5e-3, True, 1e-4, lambda doc, value: None)
+    kept = profile(present, {d: 100.0 + s for d, s in zip(depths, scatter)})
+    judge([kept], baseline, measured)
+    assert not reaches_no_change(kept)  # a present value is not judged by its bound
 
 
 # The worn arc at 195° of the slider pin fitted to a record without wear: the slider-crank's first 12 ms with a 0.36 mm

@@ -17,8 +17,8 @@ from clearsim.diagnose.candidates import Candidate
 from clearsim.diagnose.evaluate import document_text
 from clearsim.diagnose.search import SIGNIFICANCE, JointFit, Scored, smoothed_interval
 from clearsim.diagnose.search import robust_to_perturbations, significant_on_both_halves
-from clearsim.diagnose.workflow import (Diagnosis, Effect, confirmed, effect_line, explained_share, found_effect,
-                                       refit_line)
+from clearsim.diagnose.workflow import (Diagnosis, Effect, confirmed, effect_line, ensemble_line, explained_share,
+                                       found_effect, refit_line)
 from clearsim.io.hdf5 import keep_as_previous
 from clearsim.plot.style import LEGEND_WIDTH, legend_beside, new_figure, set_title, wrap_label
 
@@ -216,7 +216,8 @@ def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
         out.append(f"| {s} | {n.std:.3g} ({low:.3g}–{high:.3g}) {d.units.get(s, '')} | {NOISE_SOURCES[n.estimator]} | "
                    f"{n.effective_samples:.0f} / {n.samples} | {d.before.gaps[s]:.3g} | {d.after.gaps[s]:.3g} |")
     out += [f"| combined | | | | {d.before.gap:.3g} | {d.after.gap:.3g} |", "",
-            f"Trigger offset: {d.before.offset * 1e3:.3f} ms (fitted as a nuisance).", "", *_remaining_lines(d),
+            f"Trigger offset: {d.before.offset * 1e3:.3f} ms (fitted as a nuisance).", "",
+            f"{ensemble_line(d.ensemble).capitalize()}.", "", *_remaining_lines(d),
             *_joint_lines(d),
             "## Where the model and the record disagree (before)", "",
             "| sensor | feature | measured | model | unit |", "|---|---|---|---|---|"]

@@ -642,6 +642,15 @@ def reaches_no_change(scored: Scored) -> bool:
     return scored.interval[0] <= no_change(scored.candidate) * (1.0 + 1e-9)
 
 
+def unbounded(scored: Scored) -> bool:
+    """The candidate's interval spans its whole range: the record fixes no value of it, so its low χ² is one lucky run
+    however it compares with the model's (a present value included)."""
+    if scored.interval is None:
+        return False
+    low, high = scored.interval
+    return low <= scored.candidate.low * (1.0 + 1e-9) and high >= scored.candidate.high * (1.0 - 1e-9)
+
+
 def telling_sensor(first: Prediction, others: list[Prediction], scale: dict[str, float]) -> str | None:
     """The model sensor on which the tied models differ most (RMS difference over the sensor's range)."""
     best_name, best_score = None, 0.0

@@ -26,7 +26,7 @@ from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
 from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
 from clearsim.diagnose.search import (AS_GIVEN, PERTURBATIONS, SIGNIFICANCE, Ensembled, JointFit, PairFit, Point, Scored,
-                                     SearchProgress, candidate_pairs, fit_pair, no_change, reaches_no_change,
+                                     SearchProgress, candidate_pairs, fit_pair, no_change, reaches_no_change, unbounded,
                                      Tracked, aligned_residuals, halves_improved, judge, low_band_best, mark_ties,
                                      profile_threshold, refine, refit_jointly, robust_to_perturbations, score_point, screen,
                                      seen_by_sensors, setting, significant_on_both_halves, to_fit, twin_gaps)
@@ -507,11 +507,11 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
             f"({record.low_band.cutoff:.0f} Hz; there χ² {low_band_best(winner):.1f} against the model's "
             f"{base_point.low_band_chi_square:.1f}): chaotic detail of the impacts, not a missing effect")
         winner = None
-    if winner is not None and reaches_no_change(winner):
+    lucky = needle(winner) if winner is not None else None
+    if lucky:
         say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) but its interval "
-            f"({winner.candidate.shown(winner.interval[0])}–{winner.candidate.shown(winner.interval[1])}) reaches "
-            f"{winner.candidate.shown(no_change(winner.candidate))}, none of it: its runs scatter as much as it "
-            "improves, one lucky run, not a missing effect")
+            f"({winner.candidate.shown(winner.interval[0])}–{winner.candidate.shown(winner.interval[1])}) {lucky}: its "
+            "runs scatter as much as it improves, one lucky run, not a missing effect")
         winner = None
     if winner is not None:
         mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
@@ -522,6 +522,17 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
+
+
+def needle(scored: Scored) -> str | None:
+    """Why the candidate's best run is a needle, not a basin (docs/diagnose.md §4 step 3), or None: its interval reaches
+    the lower bound of an effect the model lacks (search.reaches_no_change), or spans its whole range
+    (search.unbounded)."""
+    if reaches_no_change(scored):
+        return f"reaches {scored.candidate.shown(no_change(scored.candidate))}, none of it"
+    if unbounded(scored):
+        return "spans the whole range"
+    return None
 
 
 def clearances_of_worn_joints(chosen: list[Scored], visible: list[Scored]) -> list[Scored]:

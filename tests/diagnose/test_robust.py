@@ -10,8 +10,9 @@ import numpy as np
 from clearsim.diagnose.align import Fit, prepare_record
 from clearsim.diagnose.candidates import WEAR_DEPTH_BOUNDS, Candidate
 from clearsim.diagnose.evaluate import Prediction
-from clearsim.diagnose.search import SIGNIFICANCE, Point, Scored, judge, no_change, reaches_no_change, twin_gaps
-from clearsim.diagnose.workflow import AUTO_ENSEMBLE, EnsembleChoice, ensemble_line
+from clearsim.diagnose.search import (SIGNIFICANCE, Point, Scored, judge, no_change, reaches_no_change, twin_gaps,
+                                     unbounded)
+from clearsim.diagnose.workflow import AUTO_ENSEMBLE, EnsembleChoice, ensemble_line, needle
 
 RATE = 10e3
 TIME = np.arange(0.0, 0.1, 1.0 / RATE)
@@ -54,17 +55,18 @@ def test_a_needle_among_scattered_runs_reaches_no_change_and_a_basin_does_not():
     assert no_change(arc) == 2e-6
     depths = np.geomspace(3e-6, 4e-4, 11)
     scatter = [25.0, -20.0, 30.0, -15.0, 10.0, -60.0, 20.0, -25.0, 15.0, 28.0, -18.0]
-    needle = profile(arc, {d: 100.0 + s for d, s in zip(depths, scatter)})
+    needle_runs = profile(arc, {d: 100.0 + s for d, s in zip(depths, scatter)})
     basin = profile(arc, {d: 100.0 - 40.0 * np.exp(-((k - 5) / 1.5) ** 2) for k, d in enumerate(depths)})
     baseline = Fit(0.0, 100.0, {}, 1.0)
-    judge([needle, basin], baseline, measured)
-    assert needle.delta_bic < -10.0 and basin.delta_bic < -10.0  # both pass the BIC on their lowest run
-    assert reaches_no_change(needle), needle.interval
+    judge([needle_runs, basin], baseline, measured)
+    assert needle_runs.delta_bic < -10.0 and basin.delta_bic < -10.0  # both pass the BIC on their lowest run
+    assert reaches_no_change(needle_runs), needle_runs.interval
     assert not reaches_no_change(basin), basin.interval
     present = Candidate("clearance", "pin", "clearance", "m", 2e-6, 0.5e-3, True, 1e-4, lambda doc, value: None)
     kept = profile(present, {d: 100.0 + s for d, s in zip(depths, scatter)})
     judge([kept], baseline, measured)
     assert not reaches_no_change(kept)  # a present value is not judged by its bound
+    assert needle(needle_runs) == "reaches 2e-06, none of it" and needle(basin) is None
 
 
 # The worn arc at 195° of the slider pin fitted to a record without wear: the slider-crank's first 12 ms with a 0.36 mm
@@ -90,3 +92,16 @@ def test_a_worn_arc_that_replays_a_chaotic_record_by_luck_is_not_named():
     assert scored.delta_bic < -SIGNIFICANCE  # the BIC alone names it
     assert scored.interval[0] <= WEAR_DEPTH_BOUNDS[0] * (1 + 1e-9)
     assert reaches_no_change(scored)
+
+
+def test_an_interval_over_the_whole_range_is_a_needle_even_for_a_present_value():
+    """A present contact stiffness (66 GN/m, range 6.6–661 GN/m) whose runs scatter by ±60 about the model's χ² 100
+    with one run 80 below: its interval spans the whole range, the record fixes no value: a needle."""
+    measured, _ = record()
+    stiffness = Candidate("stiffness", "pin", "stiffness", "N/m", 6.61e9, 6.61e11, True, 6.61e10, lambda doc, value: None)
+    values = np.geomspace(7e9, 6e11, 11)
+    scatter = [50.0, -40.0, 60.0, -30.0, 20.0, -80.0, 40.0, -50.0, 30.0, 56.0, -36.0]
+    runs = profile(stiffness, {v: 100.0 + s for v, s in zip(values, scatter)})
+    judge([runs], Fit(0.0, 100.0, {}, 1.0), measured)
+    assert runs.delta_bic < -10.0 and not reaches_no_change(runs)
+    assert unbounded(runs) and needle(runs) == "spans the whole range"

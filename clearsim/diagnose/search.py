@@ -31,6 +31,9 @@ After greedy selection has found several effects, `refit_jointly` refits all the
 a stencil around the best values in the candidates' unit coordinates, a quadratic surface through it
 and a run at its minimum, the step halved each round.
 
+When greedy selection finds nothing, `fit_pair` fits a pair of candidates together: a coarse 4 × 4 grid in their unit
+coordinates, then the joint refit's stencil rounds (`refine_jointly`) about its best point.
+
 Candidates are ranked by the Bayesian information criterion BIC = χ²_min + k ln n_eff (k = 1 fitted
 parameter; the trigger offset is fitted in every model alike), so a candidate must lower χ² by more
 than ln n_eff + SIGNIFICANCE to count as found: noise alone does not pass.

@@ -6,7 +6,10 @@ Greedy forward selection: each iteration fits every candidate effect to the reco
 model as it stands (the original plus the effects found so far), keeps the best one if its BIC
 beats the model's by SIGNIFICANCE, and stops when none does or `max_effects` are found. Several
 effects found are then refitted together (search.refit_jointly); their reported values, intervals
-and gaps are the joint ones, their evidence (ΔBIC, ties, halves) the greedy step's that found them.
+and gaps are the joint ones, their evidence (ΔBIC, ties, halves) the greedy step's that found them. When the first
+iteration finds nothing and the model misses the record by more than the noise, with max_effects ≥ 2 the most promising
+pairs of candidates are fitted together (pairwise_search). Runs per candidate value: the ensemble chosen from the
+model's re-rolled twins (chosen_ensemble).
 """
 
 from __future__ import annotations

@@ -492,7 +492,7 @@ def diagnose(
     workers: Optional[int] = typer.Option(None, "--workers", help="Local worker processes (default: all cores)."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Run the simulations on a Dask cluster: tcp://host:8786."),
     fit_top: int = typer.Option(3, "--fit-top", help="Candidates fitted in full per iteration (the best of the screening)."),
-    ensemble: int = typer.Option(1, "--ensemble", help="Runs per candidate value with a rattling joint (perturbed by 1 nm): its cost is their median."),
+    ensemble: Optional[int] = typer.Option(None, "--ensemble", help="Runs per candidate value with a rattling joint (perturbed by 1 nm): its cost is their median (default: 3 where the model's re-rolled twins stray by more than the noise, else 1)."),
 ) -> None:
     """Compare a model with measured data, name the missing effect, add it and show the gap shrink."""
     from clearsim.diagnose.report import verdict, write_report

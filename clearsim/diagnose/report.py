@@ -17,8 +17,8 @@ from clearsim.diagnose.candidates import Candidate
 from clearsim.diagnose.evaluate import document_text
 from clearsim.diagnose.search import SIGNIFICANCE, JointFit, Scored, smoothed_interval
 from clearsim.diagnose.search import robust_to_perturbations, significant_on_both_halves
-from clearsim.diagnose.workflow import (Diagnosis, Effect, confirmed, effect_line, explained_share, found_effect,
-                                       refit_line)
+from clearsim.diagnose.workflow import (Diagnosis, Effect, confirmed, effect_line, ensemble_line, explained_share,
+                                       found_effect, refit_line)
 from clearsim.io.hdf5 import keep_as_previous
 from clearsim.plot.style import LEGEND_WIDTH, legend_beside, new_figure, set_title, wrap_label
 
@@ -113,7 +113,13 @@ def diagnosis_document(d: Diagnosis) -> dict:
                   for s, n in d.record.noise.items()},
         "repeats": [str(path) for path in d.request.repeats],
         "comparison_lowpass_hz": d.record.cutoff,
+        "ensemble": {"runs": d.ensemble.runs, "automatic": d.ensemble.automatic, "twin_gaps": d.ensemble.twin_gaps,
+                     "impact_rich": d.ensemble.impact_rich},
         "joint_refit": _joint(d.joint),
+        "pairs": [{"effects": [c.label for c in pair.candidates], "values": list(pair.joint.best.value),
+                   "delta_bic": pair.delta_bic, "gap": pair.joint.best.fit.gap, "runs": len(pair.joint.points)}
+                  for pair in d.pairs],
+        "found_as_pair": d.found_as_pair,
         "iterations": [{"gap": it.baseline.gap, "found": _effect(found_effect(it.found, it.baseline)) if it.found else None,
                         "ranking": _ranking(it.ranked),
                         "windows": [{"sensor": w.sensor, "start_s": w.start, "end_s": w.end, "peak_noise_levels": w.peak}
@@ -210,7 +216,8 @@ def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
         out.append(f"| {s} | {n.std:.3g} ({low:.3g}–{high:.3g}) {d.units.get(s, '')} | {NOISE_SOURCES[n.estimator]} | "
                    f"{n.effective_samples:.0f} / {n.samples} | {d.before.gaps[s]:.3g} | {d.after.gaps[s]:.3g} |")
     out += [f"| combined | | | | {d.before.gap:.3g} | {d.after.gap:.3g} |", "",
-            f"Trigger offset: {d.before.offset * 1e3:.3f} ms (fitted as a nuisance).", "", *_remaining_lines(d),
+            f"Trigger offset: {d.before.offset * 1e3:.3f} ms (fitted as a nuisance).", "",
+            f"{ensemble_line(d.ensemble).capitalize()}.", "", *_remaining_lines(d),
             *_joint_lines(d),
             "## Where the model and the record disagree (before)", "",
             "| sensor | feature | measured | model | unit |", "|---|---|---|---|---|"]
@@ -236,6 +243,10 @@ def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:
 def _joint_lines(d: Diagnosis) -> list[str]:
     if d.joint is None:
         return []
+    if d.found_as_pair:
+        return [f"Neither effect alone beat the model significantly; the pairwise search fitted them together "
+                f"({len(d.joint.points)} runs: a coarse grid, then refined), ΔBIC {d.effects[0].scored.delta_bic:.0f} "
+                "counting both parameters. ΔBIC and the halves above are the pair's.", ""]
     return [f"The {len(d.effects)} effects were found one after another, then {refit_line(d.joint, d.effects)}. "
             "The values, intervals and gaps above are the refitted ones; ΔBIC is the evidence of the step that "
             "found each effect.", ""]

@@ -31,6 +31,9 @@ After greedy selection has found several effects, `refit_jointly` refits all the
 a stencil around the best values in the candidates' unit coordinates, a quadratic surface through it
 and a run at its minimum, the step halved each round.
 
+When greedy selection finds nothing, `fit_pair` fits a pair of candidates together: a coarse 4 × 4 grid in their unit
+coordinates, then the joint refit's stencil rounds (`refine_jointly`) about its best point.
+
 Candidates are ranked by the Bayesian information criterion BIC = χ²_min + k ln n_eff (k = 1 fitted
 parameter; the trigger offset is fitted in every model alike), so a candidate must lower χ² by more
 than ln n_eff + SIGNIFICANCE to count as found: noise alone does not pass.
@@ -47,7 +50,8 @@ from scipy.stats import chi2, norm
 from scipy.stats import f as fisher
 from scipy.stats import t as student
 
-from clearsim.diagnose.align import INTERVAL_LEVEL, Fit, Record, chi_square_halves, fit_at, fit_offset, predict, residuals
+from clearsim.diagnose.align import (INTERVAL_LEVEL, Fit, Record, chi_square_halves, fit_at, fit_offset, predict, residuals,
+                                    sensor_gaps)
 from clearsim.diagnose.candidates import Candidate, with_effects
 from clearsim.diagnose.evaluate import Evaluator, Prediction
 from clearsim.diagnose.features import dominant_frequency
@@ -214,6 +218,22 @@ def median_member(members: list):
         return members[0]
     ranked = sorted(members, key=lambda p: p.chi_square)
     return ranked[(len(ranked) - 1) // 2]
+
+
+def twin_gaps(record: Record, model: Prediction, twins: list[Prediction], offset: float) -> dict[str, float]:
+    """Per sensor, how far the model's re-rolled twins (candidates.perturbed: no bench could tell them from it) stray
+    from it: the largest RMS difference of a twin's prediction from the model's in the comparison band, over the
+    compared samples and both at the model's trigger offset, in noise levels σ̂_s (D1's gap, with a twin in the
+    record's place; a twin that fails counts as infinitely far). Above 1 the sensor is impact-rich: one run's
+    sample-wise cost there is one realisation of a chaotic impact sequence."""
+    def aligned(prediction: Prediction) -> dict[str, np.ndarray]:
+        return predict(record, prediction.time, {s: prediction.sensors[s] for s in record.values}, offset)
+
+    if not all(twin.ok for twin in twins):
+        return {s: np.inf for s in record.values}
+    own = aligned(model)
+    strays = [sensor_gaps(record, {s: own[s] - m for s, m in aligned(twin).items()}) for twin in twins]
+    return {s: max((stray[s] for stray in strays), default=0.0) for s in record.values}
 
 
 AS_GIVEN = "the model as given"
@@ -608,6 +628,32 @@ def robust_to_perturbations(scored: Scored, record: Record) -> bool:
     return len(scored.perturbed) >= PERTURBATIONS and max(scored.perturbed) < -bic_margin(record.effective_samples)
 
 
+def no_change(candidate: Candidate) -> float:
+    """The value of an effect the model lacks (a worn arc, a clearance or friction of an ideal joint) that amounts to
+    none of it: the lower bound (2 µm of wear: none to speak of)."""
+    return candidate.low
+
+
+def reaches_no_change(scored: Scored) -> bool:
+    """An effect the model lacks whose interval reaches its lower bound (no_change): its runs' own scatter
+    (LocalParabola.indistinct, the chaotic run-to-run spread of neighbouring values) is as large as its improvement
+    over the model, so its low χ² is one lucky run (a needle), not a basin. A present value (candidate.current) inside
+    the interval is not judged so: the benchmark's contact stiffness at the slider pin, rightly found, holds the
+    model's own value in its interval (docs/diagnose.md §4 step 3)."""
+    if scored.interval is None or scored.candidate.current is not None:
+        return False
+    return scored.interval[0] <= no_change(scored.candidate) * (1.0 + 1e-9)
+
+
+def unbounded(scored: Scored) -> bool:
+    """The candidate's interval spans its whole range: the record fixes no value of it, so its low χ² is one lucky run
+    however it compares with the model's (a present value included)."""
+    if scored.interval is None:
+        return False
+    low, high = scored.interval
+    return low <= scored.candidate.low * (1.0 + 1e-9) and high >= scored.candidate.high * (1.0 - 1e-9)
+
+
 def telling_sensor(first: Prediction, others: list[Prediction], scale: dict[str, float]) -> str | None:
     """The model sensor on which the tied models differ most (RMS difference over the sensor's range)."""
     best_name, best_score = None, 0.0
@@ -667,7 +713,14 @@ def refit_jointly(evaluator: Tracked, record: Record, sensors: list[str], docume
     quadratic surface fitted to the points near it (if convex), and halves the step."""
     joint = JointFit(list(candidates), tuple(float(v) for v in start))
     _run_joint(evaluator, record, sensors, document, joint, [joint.units(joint.start)])
-    step = REFIT_STEP
+    refine_jointly(evaluator, record, sensors, document, joint, REFIT_STEP, rounds)
+    return joint
+
+
+def refine_jointly(evaluator, record, sensors, document, joint: JointFit, step: float, rounds: int) -> None:
+    """`rounds` stencil rounds about the joint fit's best point, the first of `step` (unit coordinates), each followed
+    by a run at the minimum of the quadratic surface through the points near it (if convex), the step halved each
+    round."""
     for _ in range(rounds):
         centre = joint.units(joint.best.value)
         _run_joint(evaluator, record, sensors, document, joint, stencil(centre, step))
@@ -676,7 +729,6 @@ def refit_jointly(evaluator: Tracked, record: Record, sensors: list[str], docume
             _run_joint(evaluator, record, sensors, document, joint, [vertex])
         joint.step = step
         step /= 2.0
-    return joint
 
 
 def _run_joint(evaluator, record, sensors, document, joint: JointFit, units: list) -> None:
@@ -719,3 +771,58 @@ def quadratic_minimum(joint: JointFit, centre: np.ndarray, step: float) -> np.nd
         return None
     offset = np.clip(np.linalg.solve(hessian, -gradient), -REFIT_REACH, REFIT_REACH)
     return np.clip(centre + step * offset, 0.0, 1.0)
+
+
+# --- pairwise search: two effects that neither improves the record alone -------------------------------------------
+
+
+PAIRS = 3  # pairs of fitted candidates fitted together when no single one is significant
+PAIR_GRID = (0.125, 0.375, 0.625, 0.875)  # the coarse grid of a pair, per axis, in unit coordinates
+PAIR_ROUNDS = 4  # refinement rounds after the grid, the first stencil step half the grid's spacing
+
+
+@dataclass
+class PairFit:
+    """Two candidates fitted together (`joint`: their coarse grid and its refinement), and the pair's evidence."""
+
+    scored: tuple[Scored, Scored]  # their single-effect fits (screening, scan, zooms)
+    joint: JointFit
+    bic: float = np.inf  # χ²_min + (k₁ + k₂) ln n_eff
+    delta_bic: float = np.inf  # BIC − the model's χ²
+
+    @property
+    def candidates(self) -> list[Candidate]:
+        return self.joint.candidates
+
+
+def candidate_pairs(fitted: list[Scored], baseline: float, count: int = PAIRS) -> list[tuple[Scored, Scored]]:
+    """The `count` pairs of fitted candidates whose single improvements over the model (χ² − their lowest χ², negative
+    when a candidate alone only makes the fit worse) add up most; never two values of one quantity (two worn arcs of
+    one joint)."""
+    def improvement(s: Scored) -> float:
+        return baseline - s.best.chi_square
+
+    def quantity(s: Scored) -> tuple:
+        return s.candidate.kind, s.candidate.target, s.candidate.parameter
+
+    usable = [s for s in fitted if s.best is not None]
+    pairs = [(a, b) for i, a in enumerate(usable) for b in usable[i + 1:] if quantity(a) != quantity(b)]
+    return sorted(pairs, key=lambda pair: -(improvement(pair[0]) + improvement(pair[1])))[:count]
+
+
+def fit_pair(evaluator, record: Record, sensors: list[str], document: dict, pair: tuple[Scored, Scored],
+             baseline: Fit) -> PairFit | None:
+    """The pair on a coarse grid (PAIR_GRID², one parallel batch), then refined about its best point as the joint refit
+    does (refine_jointly: PAIR_ROUNDS rounds, the first step half the grid's spacing); None when no run finished. Its
+    BIC counts both candidates' parameters."""
+    joint = JointFit([s.candidate for s in pair], ())
+    _run_joint(evaluator, record, sensors, document, joint, [np.array(u) for u in np.array(np.meshgrid(
+        PAIR_GRID, PAIR_GRID)).reshape(2, -1).T])
+    if not any(p.fit is not None for p in joint.points):
+        return None
+    joint.start = joint.best.value
+    spacing = PAIR_GRID[1] - PAIR_GRID[0]
+    refine_jointly(evaluator, record, sensors, document, joint, 0.5 * spacing, PAIR_ROUNDS)
+    penalty = np.log(max(record.effective_samples, 2.0)) * sum(s.candidate.parameters for s in pair)
+    bic = joint.best.chi_square + penalty
+    return PairFit(pair, joint, bic, bic - baseline.chi_square)

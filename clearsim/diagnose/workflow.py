@@ -6,7 +6,10 @@ Greedy forward selection: each iteration fits every candidate effect to the reco
 model as it stands (the original plus the effects found so far), keeps the best one if its BIC
 beats the model's by SIGNIFICANCE, and stops when none does or `max_effects` are found. Several
 effects found are then refitted together (search.refit_jointly); their reported values, intervals
-and gaps are the joint ones, their evidence (ΔBIC, ties, halves) the greedy step's that found them.
+and gaps are the joint ones, their evidence (ΔBIC, ties, halves) the greedy step's that found them. When the first
+iteration finds nothing and the model misses the record by more than the noise, with max_effects ≥ 2 the most promising
+pairs of candidates are fitted together (pairwise_search). Runs per candidate value: the ensemble chosen from the
+model's re-rolled twins (chosen_ensemble).
 """
 
 from __future__ import annotations
@@ -25,10 +28,11 @@ from clearsim.diagnose.candidates import KINDS, Candidate, candidates_for, pertu
 from clearsim.diagnose.evaluate import Evaluator, Prediction, document_text
 from clearsim.diagnose.features import Feature, Window, disagreement_windows, features
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
-from clearsim.diagnose.search import (AS_GIVEN, PERTURBATIONS, SIGNIFICANCE, Ensembled, JointFit, Point, Scored, SearchProgress,
+from clearsim.diagnose.search import (AS_GIVEN, PERTURBATIONS, SIGNIFICANCE, Ensembled, JointFit, PairFit, Point, Scored,
+                                     SearchProgress, candidate_pairs, fit_pair, no_change, reaches_no_change, unbounded,
                                      Tracked, aligned_residuals, halves_improved, judge, low_band_best, mark_ties,
                                      profile_threshold, refine, refit_jointly, robust_to_perturbations, score_point, screen,
-                                     seen_by_sensors, setting, significant_on_both_halves, to_fit)
+                                     seen_by_sensors, setting, significant_on_both_halves, to_fit, twin_gaps)
 from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.model.loader import load_mechanism, load_mechanism_text
 from clearsim.model.resolve import is_clearance_joint
@@ -59,7 +63,8 @@ class DiagnoseRequest:
     lowpass: str | None = None  # the bench's filter if known
     fit_top: int = FIT_TOP
     repeats: list[Path] = field(default_factory=list)  # further records of the same test: the noise from their spread
-    ensemble: int = 1  # runs per candidate value (the given one and perturbed twins): its cost is their median
+    ensemble: int | None = None  # runs per candidate value (the given one and perturbed twins): its cost is their
+    # median; None: chosen from the model's twins (AUTO_ENSEMBLE on an impact-rich record, else 1)
 
 
 @dataclass
@@ -93,6 +98,23 @@ def found_effect(scored: Scored, before: Fit) -> Effect:
     return Effect(scored, scored.estimate.value, scored.interval, scored.estimate, before)
 
 
+@dataclass(frozen=True)
+class EnsembleChoice:
+    """Runs per candidate value (K) and why: given with --ensemble, or chosen from how far the model's re-rolled twins
+    stray from it on each sensor (search.twin_gaps; empty when not measured: given, or no clearance joint)."""
+
+    runs: int
+    twin_gaps: dict[str, float]
+    automatic: bool
+
+    @property
+    def impact_rich(self) -> list[str]:
+        """The sensors on which the twins stray by more than the noise."""
+        return [s for s, gap in self.twin_gaps.items() if gap > IMPACT_RICH]
+
+
+AUTO_ENSEMBLE = 3  # runs per value on an impact-rich record: the median of three outvotes one lucky realisation
+IMPACT_RICH = 1.0  # a sensor on which the model's twins stray by more than one noise level (RMS) is impact-rich
 HELPFUL_SENSORS = 2  # model sensors named as the ones to add to the bench
 SENSED = 1e-4  # of a sensor's range: an effect that changes it by less (RMS) leaves it as it is
 ENSEMBLE_SEED = 100  # the ensemble's twins are seeded 101, 102, …: other draws than the robustness check's 1, 2, 3
@@ -128,6 +150,14 @@ class Diagnosis:
     wall_time: float
     units: dict
     check: RecordCheck
+    ensemble: EnsembleChoice
+    pairs: list[PairFit]  # the pairs fitted together when no single effect was significant (--max-effects ≥ 2)
+
+    @property
+    def found_as_pair(self) -> bool:
+        """The effects were found together by the pairwise search, not one after another."""
+        pair = significant_pair(self.pairs)
+        return pair is not None and self.joint is pair.joint
 
     @property
     def before(self) -> Fit:
@@ -225,7 +255,7 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
     started = clock.perf_counter()
     if request.max_effects < 1:
         raise DiagnoseError(f"--max-effects must be at least 1, got {request.max_effects}")
-    if request.ensemble < 1:
+    if request.ensemble is not None and request.ensemble < 1:
         raise DiagnoseError(f"--ensemble must be at least 1 (runs per candidate value), got {request.ensemble}")
     if request.fit_top < 1:
         raise DiagnoseError(f"--fit-top must be at least 1 (the candidates fitted in full per iteration), "
@@ -256,15 +286,18 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
     executor = _executor(request)
     evaluator = Tracked(Evaluator(folder / "runs", str(request.config), Path(request.config).parent, executor,
                                   record.rate), progress)
-    if request.ensemble > 1:
-        evaluator = Ensembled(evaluator, lambda document: ensemble_copies(document, request))
     iterations: list[Iteration] = []
     joint = None
+    pairs: list[PairFit] = []
     try:
         evaluator.stage("estimating the noise")
         noise = record_noise(evaluator, record, sensors, document, repeats, request)
         record = prepare_record(measured.time, measured.values, cutoff, noise)
         say(_record_line(record))
+        ensemble = chosen_ensemble(evaluator, record, document, request)
+        say(ensemble_line(ensemble))
+        if ensemble.runs > 1:
+            evaluator = Ensembled(evaluator, lambda document: ensemble_copies(document, request, ensemble.runs))
         found_keys: set = set()
         for number in range(1, request.max_effects + 1):
             iteration = _iterate(evaluator, record, sensors, document, kinds, found_keys, units, request, number, say)
@@ -274,7 +307,15 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
             found_keys.add(iteration.found.candidate.key)
             document = iteration.found.candidate.applied(document, iteration.found.estimate.value)
         effects = [found_effect(it.found, it.baseline) for it in iterations if it.found is not None]
-        if len(effects) >= 2:
+        if not effects and request.max_effects >= 2:
+            pairs = pairwise_search(evaluator, record, sensors, original, iterations[0], say)
+            best_pair = significant_pair(pairs)
+            if best_pair is not None:
+                joint = best_pair.joint
+                effects = pair_effects(evaluator, record, sensors, original, best_pair, iterations[0])
+                document = with_effects(original, best_pair.candidates, [e.value for e in effects])
+                say(f"  found together: {'; '.join(effect_line(e) for e in effects)} (ΔBIC {best_pair.delta_bic:.0f})")
+        elif len(effects) >= 2:
             evaluator.stage(f"refitting {len(effects)} effects together")
             joint = refit_jointly(evaluator, record, sensors, original, [e.candidate for e in effects],
                                   [e.value for e in effects])
@@ -288,7 +329,7 @@ def diagnose(request: DiagnoseRequest, say: Callable[[str], None] = lambda text:
     offset = final.fit.offset if final else iterations[0].baseline.offset
     check = record_check(record, sensors, prediction, offset, iterations[0])
     return Diagnosis(request, folder, measured, record, sensors, original, document, iterations, effects, joint,
-                     evaluator.simulations, clock.perf_counter() - started, units, check)
+                     evaluator.simulations, clock.perf_counter() - started, units, check, ensemble, pairs)
 
 
 def record_check(record: Record, sensors: list[str], prediction: Prediction, offset: float,
@@ -347,6 +388,44 @@ def refitted(evaluator, record: Record, sensors: list[str], document: dict, effe
     befores = [effects[0].before] + [p.fit for p in points[:-1]]
     return [Effect(e.scored, v, i, p, b)
             for e, v, i, p, b in zip(effects, values, joint.intervals(allowance), points, befores)]
+
+
+def pairwise_search(evaluator, record: Record, sensors: list[str], document: dict, first: Iteration,
+                    say: Callable[[str], None]) -> list[PairFit]:
+    """When no single effect is significant but the model as given misses the record by more than the noise
+    (align.noise_test), the PAIRS most promising pairs of the fitted candidates (search.candidate_pairs), each fitted
+    together (search.fit_pair); none when the model's gap is noise."""
+    residual = aligned_residuals(record, first.baseline_prediction, first.baseline.offset)
+    if noise_test(record, residual).consistent:
+        return []
+    pairs = candidate_pairs([s for s in first.ranked if s.fitted], first.baseline.chi_square)
+    fits = []
+    for number, pair in enumerate(pairs, start=1):
+        evaluator.stage(f"pairwise search: pair {number} of {len(pairs)}")
+        fit = fit_pair(evaluator, record, sensors, document, pair, first.baseline)
+        if fit is not None:
+            fits.append(fit)
+            say(f"  pair: {setting(fit.candidates, fit.joint.best.value)}: ΔBIC {fit.delta_bic:.0f}, "
+                f"gap {first.baseline.gap:.3g} → {fit.joint.best.fit.gap:.3g} ({len(fit.joint.points)} runs)")
+    return fits
+
+
+def significant_pair(pairs: list[PairFit]) -> PairFit | None:
+    """The pair of lowest BIC if it beats the model by SIGNIFICANCE (its BIC counting both parameters)."""
+    best = min(pairs, key=lambda pair: pair.bic, default=None)
+    return best if best is not None and best.delta_bic < -SIGNIFICANCE else None
+
+
+def pair_effects(evaluator, record: Record, sensors: list[str], document: dict, pair: PairFit,
+                 first: Iteration) -> list[Effect]:
+    """The pair's two effects as reported (refitted: each with the model with it and the one before it), their evidence
+    the pair's: its ΔBIC and its improvement on each half of the record."""
+    baseline = Point(0.0, first.baseline, first.baseline_prediction)
+    halves = halves_improved(record, baseline, pair.joint.best)
+    evidence = [Scored(s.candidate, list(s.points), fitted=True, bic=pair.bic, delta_bic=pair.delta_bic, halves=halves)
+                for s in pair.scored]
+    start = [Effect(e, v, (v, v), pair.joint.best, first.baseline) for e, v in zip(evidence, pair.joint.best.value)]
+    return refitted(evaluator, record, sensors, document, start, pair.joint)
 
 
 def refit_line(joint: JointFit, effects: list[Effect]) -> str:
@@ -431,6 +510,12 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
             f"({record.low_band.cutoff:.0f} Hz; there χ² {low_band_best(winner):.1f} against the model's "
             f"{base_point.low_band_chi_square:.1f}): chaotic detail of the impacts, not a missing effect")
         winner = None
+    lucky = needle(winner) if winner is not None else None
+    if lucky:
+        say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) but its interval "
+            f"({winner.candidate.shown(winner.interval[0])}–{winner.candidate.shown(winner.interval[1])}) {lucky}: its "
+            "runs scatter as much as it improves, one lucky run, not a missing effect")
+        winner = None
     if winner is not None:
         mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
         winner.halves = halves_improved(record, base_point, winner.estimate)
@@ -440,6 +525,17 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
+
+
+def needle(scored: Scored) -> str | None:
+    """Why the candidate's best run is a needle, not a basin (docs/diagnose.md §4 step 3), or None: its interval reaches
+    the lower bound of an effect the model lacks (search.reaches_no_change), or spans its whole range
+    (search.unbounded)."""
+    if reaches_no_change(scored):
+        return f"reaches {scored.candidate.shown(no_change(scored.candidate))}, none of it"
+    if unbounded(scored):
+        return "spans the whole range"
+    return None
 
 
 def clearances_of_worn_joints(chosen: list[Scored], visible: list[Scored]) -> list[Scored]:
@@ -458,13 +554,43 @@ def worn_arcs_between(ranked: list[Scored], mechanism, known: set) -> list[Score
     return [Scored(c) for c in wear_between(mechanism, ranked[0].candidate) if c.key not in known]
 
 
-def ensemble_copies(document: dict, request: DiagnoseRequest) -> list[dict]:
-    """The document and its request.ensemble − 1 perturbed twins (seeds 101, 102, …); without a clearance joint, nothing
-    chaotic to re-roll: the document alone."""
+def ensemble_copies(document: dict, request: DiagnoseRequest, runs: int) -> list[dict]:
+    """The document and its runs − 1 perturbed twins (seeds 101, 102, …); without a clearance joint, nothing chaotic to
+    re-roll: the document alone."""
     mechanism = _mechanism(document, request)
     if not any(is_clearance_joint(j) for j in mechanism.joints):
         return [document]
-    return [document] + [perturbed(mechanism, document, ENSEMBLE_SEED + seed) for seed in range(1, request.ensemble)]
+    return [document] + [perturbed(mechanism, document, ENSEMBLE_SEED + seed) for seed in range(1, runs)]
+
+
+def chosen_ensemble(evaluator, record: Record, document: dict, request: DiagnoseRequest) -> EnsembleChoice:
+    """K as given (--ensemble), else from the model as given and its AUTO_ENSEMBLE − 1 twins (the ensemble's own, so the
+    screening reuses their runs): AUTO_ENSEMBLE when they stray from the model by more than the noise on a sensor
+    (IMPACT_RICH), 1 when they do not or the model has no clearance joint (nothing chaotic to re-roll)."""
+    if request.ensemble is not None:
+        return EnsembleChoice(request.ensemble, {}, automatic=False)
+    copies = ensemble_copies(document, request, AUTO_ENSEMBLE)
+    if len(copies) == 1:
+        return EnsembleChoice(1, {}, automatic=True)
+    model, *twins = evaluator.evaluate(copies, lambda i, prediction: prediction,
+                                       [AS_GIVEN] + [f"{AS_GIVEN}, re-rolled ({n})" for n in range(1, len(copies))])
+    check_model(model, request)
+    offset = fit_offset(record, model.time, {s: model.sensors[s] for s in record.values}).offset
+    gaps = twin_gaps(record, model, twins, offset)
+    rich = any(gap > IMPACT_RICH for gap in gaps.values())
+    return EnsembleChoice(AUTO_ENSEMBLE if rich else 1, gaps, automatic=True)
+
+
+def ensemble_line(choice: EnsembleChoice) -> str:
+    """'ensemble: 3 runs per value (impact-rich: slider_velocity; twins stray 0.31, 2.4 noise levels)'."""
+    runs = f"ensemble: {choice.runs} run{'' if choice.runs == 1 else 's'} per value"
+    if not choice.automatic:
+        return f"{runs} (--ensemble)"
+    if not choice.twin_gaps:
+        return f"{runs} (no clearance joint: nothing chaotic to re-roll)"
+    strays = ", ".join(f"{s} {gap:.3g}" for s, gap in choice.twin_gaps.items())
+    rich = ", ".join(choice.impact_rich)
+    return f"{runs} ({'impact-rich: ' + rich if rich else 'no sensor impact-rich'}; re-rolled twins stray {strays} noise levels)"
 
 
 def perturbed_changes(evaluator, record: Record, sensors: list[str], document: dict, winner: Scored, baseline: Point,

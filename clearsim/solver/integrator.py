@@ -643,11 +643,15 @@ def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real
         update_output_peak(n, y, f, real)
 
 
-# the kernels `advance` takes by address, in its argument order (addressed_kernels)
-ADDRESSED = (switch_mode, project_state, forces_and_accelerations, rosenbrock.attempt)
+def addressed(method: int) -> tuple:
+    """The kernels `advance` takes by address for a run of `method` (DOPRI5, ROSENBROCK), in its argument order: the
+    Rosenbrock step where it is the method, else its stand-in of the same type (rosenbrock.not_taken, never called),
+    so that only a run that takes the Rosenbrock step compiles it. Both give `advance` the same type."""
+    step_kernel = rosenbrock.attempt if method == ROSENBROCK else rosenbrock.not_taken
+    return (switch_mode, project_state, forces_and_accelerations, step_kernel)
 
 
-def addressed_kernels(system_type) -> list:
+def addressed_kernels(system_type, method: int) -> list:
     """(kernel, numba function type) of each kernel `advance` takes by address, in its argument order.
 
     A kernel called by address is compiled once, as a library of its own, instead of being linked into (and
@@ -657,18 +661,20 @@ def addressed_kernels(system_type) -> list:
     the two processes share them and meet in the middle."""
     F, I, V, IV, M = types.float64, types.int64, types.float64[::1], types.int64[::1], types.float64[:, ::1]
     dynamics, projection = dynamics_type(system_type), projection_type(system_type)
+    implicit_step = V(system_type, dynamics, F, V, V, F, IV, V, M, V, M, IV, types.boolean, F)
     signature = {
-        rosenbrock.attempt: V(system_type, dynamics, F, V, V, F, IV, V, M, V, M, IV, types.boolean, F),
+        rosenbrock.attempt: implicit_step,
+        rosenbrock.not_taken: implicit_step,
         switch_mode: F(system_type, dynamics, projection, I, I, F, V, IV, V, IV, V, IV, IV, V, V, V, V),
         project_state: projection.signature,
         forces_and_accelerations: dynamics.signature,
     }
-    return [(kernel, types.FunctionType(signature[kernel])) for kernel in ADDRESSED]
+    return [(kernel, types.FunctionType(signature[kernel])) for kernel in addressed(method)]
 
 
-def loop_arguments(system, *state):
-    """advance's arguments for a system's kernel arrays and the run's state arrays (and t_stop)."""
-    return (system, *ADDRESSED, *state)
+def loop_arguments(system, method: int, *state):
+    """advance's arguments for a system's kernel arrays, the run's method and its state arrays (and t_stop)."""
+    return (system, *addressed(method), *state)
 
 
 def compiled_loop(arguments: tuple):
@@ -677,8 +683,9 @@ def compiled_loop(arguments: tuple):
     compiled for it, so arguments of other types fail instead of compiling a second loop that links them in."""
     global _loop_ready
     if not _loop_ready:
-        addressed = {id(kernel): kind for kernel, kind in addressed_kernels(typeof(arguments[0]))}
-        advance.compile(tuple(addressed.get(id(value)) or typeof(value) for value in arguments))
+        kinds = {id(kernel): kind for method in METHODS.values() for kernel, kind in addressed_kernels(
+            typeof(arguments[0]), method)}
+        advance.compile(tuple(kinds.get(id(value)) or typeof(value) for value in arguments))
         advance.disable_compile()
         _loop_ready = True
     return advance

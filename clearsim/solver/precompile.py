@@ -4,7 +4,8 @@ numba compiles in one thread per process. A run compiles the assembly's kernels,
 loop's first call, the kernels `advance` takes by address (integrator.addressed_kernels: the mode switch, the
 projection, the dynamics), one after the other in its argument order. When the cache holds no `advance`, the first
 run (`prepare`) starts `python -m clearsim.solver.precompile`, which compiles into the same cache the kernels the
-run's typing of `advance` needs early (`AHEAD`) and then those taken by address in the reverse order, the largest
+run's typing of `advance` needs early (`AHEAD`) and then those taken by address (an explicit run's: the Rosenbrock
+step's stand-in; a Rosenbrock run compiles its step itself) in the reverse order, the largest
 first (`kernels_ahead`). When the run reaches a kernel
 the helper has already written, numba loads it from the cache instead of compiling it (the same machine code: the
 cache is keyed by the sources and the signature), so the two processes meet in the middle of that list. Where they
@@ -33,7 +34,7 @@ from numba.core import config
 
 from clearsim.assembly.arrays import KernelArraysType, blas_hidden
 from clearsim.assembly.dynamics import dynamics_type
-from clearsim.solver.integrator import addressed_kernels, advance
+from clearsim.solver.integrator import DOPRI5, addressed_kernels, advance
 
 LOCK_NAME = "compile-ahead.lock"
 BUSY_NAME = "compile-ahead.busy"  # the kernel the helper is compiling now, for the run to wait for instead
@@ -97,12 +98,17 @@ def kernels_ahead():
     ahead = [(getattr(importlib.import_module(module), name),
               (system, *(dynamics if argument is D else argument for argument in arguments)))
              for module, name, arguments in AHEAD]
-    return ahead + [(kernel, kind.signature) for kernel, kind in reversed(addressed_kernels(system))]
+    return ahead + [(kernel, kind.signature) for kernel, kind in reversed(addressed_kernels(system, DOPRI5))]
 
 
 def cache_is_cold() -> bool:
     """No compiled `advance` in the kernel cache (numba's index file for it is missing)."""
-    index = getattr(getattr(getattr(advance, "_cache", None), "_cache_file", None), "_index_path", None)
+    return not_cached(advance)
+
+
+def not_cached(kernel) -> bool:
+    """No compiled `kernel` (a cached numba dispatcher) in the kernel cache: numba's index file for it is missing."""
+    index = getattr(getattr(getattr(kernel, "_cache", None), "_cache_file", None), "_index_path", None)
     return index is not None and not Path(index).exists()
 
 
@@ -192,20 +198,19 @@ def wait_while_helper_compiles(kernel) -> float:
     return time.monotonic() - started
 
 
-_addressed_ready = False
+_addressed_ready: set[int] = set()  # the methods whose kernels this process has compiled or loaded
 
 
-def compile_addressed(kernel_arrays) -> None:
+def compile_addressed(kernel_arrays, method: int) -> None:
     """Before the loop's first call in a process: each kernel `advance` takes by address compiled here, or loaded from
     the cache, in advance's argument order, as the call would convert them — except that one the helper is compiling
     at that moment is waited for and loaded, not compiled by both processes (where the two meet in the middle)."""
-    global _addressed_ready
-    if _addressed_ready:
+    if method in _addressed_ready:
         return
-    for kernel, kind in addressed_kernels(typeof(kernel_arrays)):
+    for kernel, kind in addressed_kernels(typeof(kernel_arrays), method):
         wait_while_helper_compiles(kernel)
         kernel.compile(kind.signature)
-    _addressed_ready = True
+    _addressed_ready.add(method)
 
 
 if __name__ == "__main__":

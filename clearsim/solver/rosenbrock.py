@@ -191,6 +191,13 @@ def attempt(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian
 
 
 @njit(cache=True)
+def not_taken(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian, jacobian_modes, take_jacobian, floor):
+    """attempt's stand-in, of its type, in the loop of a run with the explicit method, which never calls it: such a run
+    then does not compile the Rosenbrock step (about 6 s of a first run on two cores; integrator.addressed)."""
+    return y_new
+
+
+@njit(cache=True)
 def lu_factor(matrix, pivots):
     """LU with partial pivoting in place (Doolittle; L's unit diagonal implied); pivots[i] = the row swapped with i."""
     n = matrix.shape[0]

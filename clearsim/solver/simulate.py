@@ -248,7 +248,9 @@ class Run:
         # compiled rhs from Python instead would load a second copy of the dynamics (docs/performance.md)
         self.wall_time = 0.0
         self.kernel_time = 0.0
-        self.kernels_compiled = precompile.cache_is_cold()
+        # the loop, or the Rosenbrock step only a Rosenbrock run compiles (integrator.addressed), is not in the cache
+        self.kernels_compiled = precompile.cache_is_cold() or (
+            settings.method == "rosenbrock" and precompile.not_cached(ig.addressed(ig.ROSENBROCK)[-1]))
         self.coordinate_count = n
         self.watched = (0, 0.0)  # tried steps and time where the stretch being watched began (judge_pace)
         self.pace_warnings: list[str] = []
@@ -295,11 +297,12 @@ class Run:
 
     def _advance(self, t_stop: float) -> None:
         started = clock.perf_counter()
-        arguments = ig.loop_arguments(self.kernel_arrays, self.y, self.f, self.real, self.ints, self.modes, self.speeds,
+        method = int(self.ints[ig.I_METHOD])
+        arguments = ig.loop_arguments(self.kernel_arrays, method, self.y, self.f, self.real, self.ints, self.modes, self.speeds,
                                       self.episode_of, *self.log, self.peak_force, self.jacobian, self.jacobian_modes,
                                       *self.buffers, t_stop)
         loop = ig.compiled_loop(arguments)
-        precompile.compile_addressed(self.kernel_arrays)  # once per process, before the loop's first call
+        precompile.compile_addressed(self.kernel_arrays, method)  # once per process and method, before its first call
         loop(*arguments)
         if self.ints[ig.I_STATUS] == ig.FIRST_STEP:  # the first call: loads (or compiles) the loop, one rhs
             self.kernel_time += clock.perf_counter() - started

@@ -21,6 +21,7 @@ from clearsim.runner import BUNDLED_CONFIG, simulate_config
 from clearsim.solver.precompile import DISABLE_VARIABLE, kernels_ahead
 
 ROOT = Path(__file__).resolve().parents[2]
+CRANK = BUNDLED_CONFIG.parent / "slider_crank_flores.yaml"
 SCRIPT = """
 import collections, sys
 from numba.core import event
@@ -30,7 +31,7 @@ with event.install_recorder("numba:compile") as recorder:
         print(" ".join(compile_ahead()))
     else:
         from clearsim.runner import simulate_config
-        simulate_config(sys.argv[1], ["solver.t_end=1ms"], sys.argv[2])
+        simulate_config(sys.argv[1], ["solver.t_end=1ms", *sys.argv[3:]], sys.argv[2])
         print()
 counts = collections.Counter()
 for _, compile_event in recorder.buffer:
@@ -66,6 +67,12 @@ def test_helper_then_run_compile_every_kernel_once_with_the_same_results(tmp_pat
     assert len(by_helper) + len(by_run) > 50 and "clearsim.solver.integrator.advance" in by_run  # an empty cache
     assert [name for name, count in {**by_helper, **by_run}.items() if count > 1] == []
     assert sorted(by_helper.keys() & by_run.keys()) == []  # the run loaded all the helper wrote
+    step = "clearsim.solver.rosenbrock.attempt"
+    assert step not in by_helper and step not in by_run  # an explicit run compiles no Rosenbrock step (its stand-in)
+    _, by_implicit = _compiled(env, CRANK, tmp_path / "implicit.h5", "solver.method=rosenbrock")
+    assert by_implicit.get(step) == 1 and "clearsim.solver.integrator.advance" not in by_implicit  # the same loop
+    with h5py.File(tmp_path / "implicit.h5") as implicit:
+        assert bool(implicit.attrs["kernels_compiled"])  # its step was compiled: the run says so
 
     simulate_config(BUNDLED_CONFIG, ["solver.t_end=1ms"], tmp_path / "suite-cache-filled.h5")  # compiles if cold
     simulate_config(BUNDLED_CONFIG, ["solver.t_end=1ms"], tmp_path / "suite-cache.h5")

@@ -495,7 +495,7 @@ def method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stag
     if ints[I_METHOD] == ROSENBROCK:
         error = implicit_step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian, jacobian_modes,
                               take_jacobian, real[R_ATOL] / real[R_RTOL])
-        taken = rosenbrock.jacobian_evaluations(system, y, jacobian_modes) if take_jacobian else 0
+        taken = rosenbrock.jacobian_evaluations(jacobian_modes) if take_jacobian else 0
         return error, rosenbrock.STAGES + taken
     return step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new), 6
 

@@ -104,7 +104,7 @@ def film_columns(system, y):
 @njit(cache=True)
 def refreshes_all_columns(modes, jacobian_modes):
     """evaluate_jacobian takes every column anew, not only the film's: none taken yet, the contact modes changed since
-    the last full one, or it has served SLOW_COLUMNS_MAX_AGE Jacobians (jacobian_modes[-1], below)."""
+    the last full one, or it has served SLOW_COLUMNS_MAX_AGE Jacobians (jacobian_modes[len(modes)], evaluate_jacobian)."""
     served = jacobian_modes[modes.shape[0]]
     if served == 0 or served >= SLOW_COLUMNS_MAX_AGE:
         return True
@@ -122,8 +122,8 @@ def evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, skipped_from,
     an oil film depends on (film_columns); the columns of the integrated powers (skipped_from, skipped_count: f does
     not depend on them) are zero. The other columns are kept from the last full Jacobian while it has served fewer
     than SLOW_COLUMNS_MAX_AGE and the modes are those it was taken in (refreshes_all_columns); jacobian_modes holds
-    those modes and, in its last slot, the Jacobians taken since (1 right after a full one, 0 before the first).
-    Returns the rhs evaluations made.
+    those modes, then the Jacobians taken since (1 right after a full one, 0 before the first), then the rhs
+    evaluations this one made (jacobian_evaluations). Returns those evaluations.
 
     The film force is homogeneous of degree one in its rates (ε̇, ε w) and turns with their direction (the
     cavitated half moves with it), so it is curved on the scale of the relative speed in the film, c |(2ε̇, ε w)|
@@ -166,17 +166,14 @@ def evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, skipped_from,
         jacobian[i, ny] = (column[i] - f[i]) / increment
     copy_into(jacobian_modes, modes)
     jacobian_modes[modes.shape[0]] = 1 if every_column else jacobian_modes[modes.shape[0]] + 1
+    jacobian_modes[modes.shape[0] + 1] = count + 1
     return count + 1
 
 
 @njit(cache=True)
-def jacobian_evaluations(system, y, jacobian_modes):
-    """The rhs evaluations the last evaluate_jacobian made for a state like y: after a full one, one per column but
-    the integrated powers'; else one per film column (film_columns); one more per film column, and one for ∂f/∂t."""
-    film = np.count_nonzero(film_columns(system, y))
-    if jacobian_modes[jacobian_modes.shape[0] - 1] == 1:
-        return y.shape[0] - WORK_COUNT + film + 1
-    return 2 * film + 1
+def jacobian_evaluations(jacobian_modes):
+    """The rhs evaluations the last evaluate_jacobian made (its record in jacobian_modes' last slot)."""
+    return jacobian_modes[jacobian_modes.shape[0] - 1]
 
 
 @njit(cache=True)

@@ -231,7 +231,8 @@ class Run:
         # rosenbrock: ∂f/∂y and ∂f/∂t (last column), and the contact modes it was taken in
         size = self.y.size if settings.method == "rosenbrock" else 0
         self.jacobian = np.zeros((size, size + 1))
-        self.jacobian_modes = np.zeros(nc + 1, np.int64)  # and the Jacobians taken since a full one (rosenbrock)
+        # and the Jacobians taken since a full one, and the rhs evaluations of the last (rosenbrock.evaluate_jacobian)
+        self.jacobian_modes = np.zeros(nc + 2, np.int64)
         dt = 1.0 / output_rate(system)
         self.real[[ig.R_T_END, ig.R_RTOL, ig.R_ATOL, ig.R_MAX_STEP, ig.R_MIN_STEP, ig.R_SAMPLE_DT]] = (
             settings.t_end, settings.rtol, settings.atol, settings.max_step, settings.min_step, dt)

@@ -305,12 +305,12 @@ def expanded_document(document: dict, mechanism, base_dir) -> dict:
 
 
 def chain_ordered(joints: list[dict]) -> list[dict]:
-    """The joints ordered along the chain: the bodies numbered by reverse Cuthill–McKee over "shares a joint", each
-    joint at the lowest number of its bodies (file order among equals). The constraint rows of joints that share a
-    body then lie near each other in their groups (pins, offsets, angles: assembly/arrays.py), so the envelope of
-    S = Φ_q M⁻¹ Φ_qᵀ, which the Cholesky factor of every right-hand side fills (assembly/dynamics.py), narrows; the
-    split links' and beam segments' joints, appended by the expansion, would otherwise reach back across all the rows
-    (docs/performance.md, "Stiff models")."""
+    """The joints ordered along the chain: the bodies numbered by reverse Cuthill–McKee over "shares a joint", from
+    the end where the file's first joint is, each joint at the highest number of its bodies (file order among
+    equals). The constraint rows of joints that share a body then lie near each other in their groups (pins,
+    offsets, angles: assembly/arrays.py), so the envelope of S = Φ_q M⁻¹ Φ_qᵀ, which the Cholesky factor of every
+    right-hand side fills (assembly/dynamics.py), narrows; the split links' and beam segments' joints, appended by
+    the expansion, would otherwise reach back across all the rows (docs/performance.md, "Stiff models")."""
     from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import reverse_cuthill_mckee
 
@@ -322,10 +322,12 @@ def chain_ordered(joints: list[dict]) -> list[dict]:
     shared = np.zeros((len(bodies), len(bodies)), np.int8)
     for pair in ends:
         shared[np.ix_([number[b] for b in pair], [number[b] for b in pair])] = 1
-    order = reverse_cuthill_mckee(csr_matrix(shared), symmetric_mode=True)
+    order = list(reverse_cuthill_mckee(csr_matrix(shared), symmetric_mode=True))
     place = {bodies[k]: position for position, k in enumerate(order)}
-    first = [min((place[body] for body in pair), default=0) for pair in ends]
-    return [joints[k] for k in sorted(range(len(joints)), key=first.__getitem__)]
+    if ends and ends[0] and max(place[body] for body in ends[0]) >= len(bodies) / 2:
+        place = {body: len(bodies) - 1 - position for body, position in place.items()}  # numbered from the other end
+    last = [max((place[body] for body in pair), default=-1) for pair in ends]
+    return [joints[k] for k in sorted(range(len(joints)), key=last.__getitem__)]
 
 
 # --- the beam element (rigid finite element method) ------------------------------------------------------------

@@ -318,6 +318,8 @@ def chain_ordered(joints: list[dict]) -> list[dict]:
 
     ends = [[body for body in joint["bodies"] if body != GROUND_NAME] for joint in joints]
     bodies = list(dict.fromkeys(body for pair in ends for body in pair))
+    if not bodies:
+        return list(joints)
     number = {body: k for k, body in enumerate(bodies)}
     shared = np.zeros((len(bodies), len(bodies)), np.int8)
     for pair in ends:

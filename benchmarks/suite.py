@@ -425,6 +425,39 @@ def at_peer_accuracy(document: dict):
     return out
 
 
+FLEXIBLE_PAIRS = (("uhv-flex-ideal", "uhv-ideal"), ("uhv-flex-c0.01", "uhv-c0.01"), ("uhv-flex-c0.1", "uhv-c0.1"))
+
+
+def flexible_pairs(quick: bool, folder: Path, measurements, repeats: int = 1) -> list[dict]:
+    """The flexible breaker's wall and integration time over the rigid one's with the same clearances, a run of each
+    in turn (`repeats` pairs, the first of each pair alternating): on a shared machine whose speed drifts between
+    minutes, cases measured one after another (the table) can each catch another phase; a pair cannot."""
+    rows = []
+    for flexible_name, rigid_name in FLEXIBLE_PAIRS:
+        cases = {name: next(c for c in CASES if c.name == name) for name in (flexible_name, rigid_name)}
+        settings = {name: case.overrides + (case.quick_overrides if quick else ()) for name, case in cases.items()}
+        for name in cases:  # warm-up: kernels loaded, caches warm
+            _run(cases[name].config, settings[name], folder, f"{name}-pair-warm-up")
+        walls, integrations = [], []
+        for k in range(max(repeats, 1)):
+            order = (flexible_name, rigid_name) if k % 2 == 0 else (rigid_name, flexible_name)
+            runs = {name: _run(cases[name].config, settings[name], folder, f"{name}-pair-{k}") for name in order}
+            walls.append(runs[flexible_name][0] / runs[rigid_name][0])
+            integrations.append(runs[flexible_name][1].statistics.wall_time / runs[rigid_name][1].statistics.wall_time)
+        rows.append({"flexible": flexible_name, "rigid": rigid_name, "pairs": len(walls),
+                     "wall_ratio_median": statistics.median(walls), "wall_ratio_min": min(walls),
+                     "wall_ratio_max": max(walls), "integration_ratio_median": statistics.median(integrations),
+                     "integration_ratio_min": min(integrations), "integration_ratio_max": max(integrations)})
+    return rows
+
+
+def describe_flexible_pairs(rows: list[dict]) -> str:
+    return "\n".join(f"{r['flexible']} / {r['rigid']} ({r['pairs']} pairs): wall {r['wall_ratio_median']:.2f}× "
+                     f"[{r['wall_ratio_min']:.2f}, {r['wall_ratio_max']:.2f}], integration "
+                     f"{r['integration_ratio_median']:.2f}× [{r['integration_ratio_min']:.2f}, "
+                     f"{r['integration_ratio_max']:.2f}]" for r in rows)
+
+
 def _paired_text(paired: dict | None) -> str:
     return f"{paired['median']:.2f}× [{paired['min']:.2f}, {paired['max']:.2f}]" if paired else ""
 
@@ -435,7 +468,7 @@ def _studies() -> dict:
     return {"chain": chain.chain, "peer": exudyn_slider_crank.peer, "baseline": solve_ivp_slider_crank.baseline,
             "baseline-cartesian": solve_ivp_cartesian.baseline,
             "compile": extras.compile_time, "memory": extras.memory, "scaling": scaling.scaling,
-            "diagnose": extras.diagnose_throughput, "sweep-keep": extras.sweep_keep}
+            "diagnose": extras.diagnose_throughput, "sweep-keep": extras.sweep_keep, "flex-pairs": flexible_pairs}
 
 
 PROFILED = ("uhv-ideal", "uhv-c0.01", "uhv-c0.1")
@@ -447,7 +480,7 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--cases", help="comma-separated names (default: all): " + ", ".join(c.name for c in CASES)
                         + ", sweep-8, profile, peer, baseline, baseline-cartesian, compile, memory, scaling, chain, diagnose, "
-                        "sweep-keep")
+                        "sweep-keep, flex-pairs")
     parser.add_argument("--json", type=Path, default=RESULTS / "latest.json")
     parser.add_argument("--compare", type=Path, help="an earlier JSON: wall-time ratios per case")
     args = parser.parse_args(argv)
@@ -502,6 +535,8 @@ def main(argv=None) -> int:
             console.print(extras.describe(name, document[name]))
     if "chain" in document:
         console.print(describe_chain(document["chain"]))
+    if "flex-pairs" in document:
+        console.print(describe_flexible_pairs(document["flex-pairs"]))
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(json.dumps(document, indent=2, default=_plain) + "\n")
     console.print(f"results: {args.json}")

@@ -26,6 +26,11 @@ def _kernel_cache_dir() -> str:
 
 
 os.environ.setdefault("NUMBA_CACHE_DIR", _kernel_cache_dir())
+# One OpenBLAS thread (read when numpy loads, so only where clearsim is imported first: the CLI, the benchmarks): the
+# assembly's and the mode report's linear algebra is on matrices of tens of rows, whose threads, woken for each call,
+# spin against the kernels on a busy machine (a 43 × 57 SVD: 0.16 s with two threads at load 8, 0.3 ms with one;
+# results bitwise the same, docs/performance.md "Stiff models").
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 if "numba.core.config" in sys.modules:
     # numba, imported first (a notebook, a test module), read the variable before it was set, and chooses each
     # kernel's cache folder when the kernel is defined: without this, ours would go next to the sources, keyed by

@@ -227,7 +227,8 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                         status, complete = f"failed: {error}", False
                 # whatever failed above, the file is flagged as far as it can still be written
                 whirls = pending.whirls()
-                warnings = run.warnings() + whirl_warnings(whirls) + pending.law_range_warnings() \
+                warnings = run.warnings() + whirl_warnings(whirls, bool(flexible_link_names(loaded.document))) \
+                    + pending.law_range_warnings() \
                     if run is not None else []
                 final = _final_attributes(run, warnings) | _mode_attributes(system, loaded, run, whirls) \
                     | _travel_attributes(system, writer) if run is not None else {}

@@ -25,8 +25,9 @@ SLOW_TURN = 3.0  # a turn that takes longer than 3× the median turn of its run 
 AT_WALL = 0.5  # median |e|/c over the window at least: the journal runs along the wall (the UHV's J: 0.9–1.5), not
 # round the bearing's centre, where the angle of a small e wanders at random
 RATE_WINDOW = 1e-3  # s: the running mean of the orbit rate (orbit_rate), ≈ 2 orbits of the UHV's whirl of J
-HINT = ("model the links' compliance, the loads that keep the journal on its wall (e.g. a gas load) or a force drive; "
-        "docs/model.md §5, \"Whirl\"")
+LOADS_HINT = ("the loads that keep the journal on its wall (e.g. a gas load) or a force drive; "
+              "docs/model.md §5, \"Whirl\"")
+HINT = f"model the links' compliance, {LOADS_HINT}"
 
 
 @dataclass(frozen=True)
@@ -114,11 +115,15 @@ def _sustained_runs(time: np.ndarray, turns: Turns) -> list[np.ndarray]:
     return runs
 
 
-def whirl_warning(joint: str, whirl: Whirl) -> str:
+def whirl_warning(joint: str, whirl: Whirl, compliant_links: bool = False) -> str:
+    """The warning of one whirl; with `compliant_links` (the file has flexible links) it does not blame rigid links
+    nor suggest the compliance the model already has."""
+    cause, hint = ("with the links' compliance in the model, and it", LOADS_HINT) if compliant_links else \
+        ("an effect of the rigid links that", HINT)
     return (f"joint {joint}: the journal whirls around its bearing from {whirl.start * 1e3:.1f} to "
             f"{whirl.end * 1e3:.1f} ms, {abs(whirl.orbits)} orbits ({hertz_text(whirl.frequency)}) while its two bodies turn "
-            f"{whirl.relative_turns:.2g} turns against each other: it runs round the bore, an effect of the rigid links "
-            f"that can set the run's peaks (hint: {HINT})")
+            f"{whirl.relative_turns:.2g} turns against each other: it runs round the bore, {cause} "
+            f"can set the run's peaks (hint: {hint})")
 
 
 def hertz_text(frequency: float) -> str:
@@ -145,6 +150,6 @@ def joint_whirls(joints: list[str], time: np.ndarray, paths: np.ndarray) -> dict
             for k, joint in enumerate(joints)}
 
 
-def whirl_warnings(whirls: dict[str, list[Whirl]]) -> list[str]:
+def whirl_warnings(whirls: dict[str, list[Whirl]], compliant_links: bool = False) -> list[str]:
     """A warning per whirl of each clearance joint (joint_whirls)."""
-    return [whirl_warning(joint, whirl) for joint, found in whirls.items() for whirl in found]
+    return [whirl_warning(joint, whirl, compliant_links) for joint, found in whirls.items() for whirl in found]

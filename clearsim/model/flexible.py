@@ -300,7 +300,36 @@ def expanded_document(document: dict, mechanism, base_dir) -> dict:
         set_velocities(expanded, velocities)
         segments = {body: expand_beam(expanded, mechanism, body, velocities[body]) for body in beams}
         set_start_moments(expanded, mechanism, segments, [split.guide for split in splits], base_dir)
+    expanded["joints"] = chain_ordered(expanded["joints"])
     return expanded
+
+
+def chain_ordered(joints: list[dict]) -> list[dict]:
+    """The joints ordered along the chain: the bodies numbered by reverse Cuthill–McKee over "shares a joint", from
+    the end where the file's first joint is, each joint at the highest number of its bodies (file order among
+    equals). The constraint rows of joints that share a body then lie near each other in their groups (pins,
+    offsets, angles: assembly/arrays.py), so the envelope of S = Φ_q M⁻¹ Φ_qᵀ, which the Cholesky factor of every
+    right-hand side fills (assembly/dynamics.py), narrows; the split links' and beam segments' joints, appended by
+    the expansion, would otherwise reach back across all the rows (docs/performance.md, "Stiff models")."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+    from clearsim.assembly.build import GROUND_NAME
+
+    ends = [[body for body in joint["bodies"] if body != GROUND_NAME] for joint in joints]
+    bodies = list(dict.fromkeys(body for pair in ends for body in pair))
+    if not bodies:
+        return list(joints)
+    number = {body: k for k, body in enumerate(bodies)}
+    shared = np.zeros((len(bodies), len(bodies)), np.int8)
+    for pair in ends:
+        shared[np.ix_([number[b] for b in pair], [number[b] for b in pair])] = 1
+    order = list(reverse_cuthill_mckee(csr_matrix(shared), symmetric_mode=True))
+    place = {bodies[k]: position for position, k in enumerate(order)}
+    if ends and ends[0] and max(place[body] for body in ends[0]) >= len(bodies) / 2:
+        place = {body: len(bodies) - 1 - position for body, position in place.items()}  # numbered from the other end
+    last = [max((place[body] for body in pair), default=-1) for pair in ends]
+    return [joints[k] for k in sorted(range(len(joints)), key=last.__getitem__)]
 
 
 # --- the beam element (rigid finite element method) ------------------------------------------------------------

@@ -4,7 +4,7 @@ carried round by its load."""
 import numpy as np
 import pytest
 
-from clearsim.whirl import MIN_ORBITS, journal_paths, orbit_angle, orbit_rate, whirl_windows
+from clearsim.whirl import MIN_ORBITS, Whirl, journal_paths, orbit_angle, orbit_rate, whirl_warnings, whirl_windows
 
 RATE = 100e3  # Hz: samples per second, the UHV model's output rate
 CLEARANCE = 1e-5  # m
@@ -92,3 +92,14 @@ def test_journal_paths_take_the_angles_of_the_bearing_and_journal_bodies_and_zer
     assert paths[:, 1, 1] == pytest.approx([0.5, 0.75])
     assert paths[:, :, 2].ravel() == pytest.approx([2.0, 0.5, 2.0, 0.5])  # |e|/c
     assert journal_paths(np.zeros((0, 2), int), np.zeros(0), states, np.zeros((2, 0, 2))).shape == (2, 0, 3)
+
+
+def test_the_warning_of_a_model_with_compliant_links_does_not_blame_rigid_links():
+    """A whirl in a model with flexible links is not "an effect of the rigid links", and modelling the links'
+    compliance is no remedy there: the other remedies stay."""
+    found = {"J": [Whirl(0.0671, 0.0806, 25, 0.0073)]}
+    (rigid,), (compliant,) = whirl_warnings(found), whirl_warnings(found, compliant_links=True)
+    assert "67.1 to 80.6 ms, 25 orbits (1.9 kHz)" in rigid and "67.1 to 80.6 ms, 25 orbits (1.9 kHz)" in compliant
+    assert "an effect of the rigid links" in rigid and "model the links' compliance" in rigid
+    assert "rigid links" not in compliant and "model the links' compliance" not in compliant
+    assert "a gas load" in compliant and "a force drive" in compliant

@@ -18,11 +18,12 @@ Python (progress bar, writing, Ctrl-C); all its state lives in the arrays of `Ru
 at the top of the loop changes no result (tested with a return every 7 steps: every result file bitwise equal).
 
 Compile time (docs/performance.md): numba compiles every kernel it calls as a library of its own,
-with all its callees linked in and optimised again. So four kernels are called by address: `advance` takes
-the mode switch, the projection, the model's dynamics (forces and constrained accelerations) and the Rosenbrock
-step (solver.method: rosenbrock; linked into the loop it added ~10 s to a compile on an empty cache) as arguments
-typed as function types (`addressed_kernels`, `compiled_loop`) and passes the projection and the dynamics on to
-the kernels that need them. Each is then compiled once, not into every library above it, and none has to be
+with all its callees linked in and optimised again. So five kernels are called by address: `advance` takes
+the mode switch, the projection, the model's dynamics (forces and constrained accelerations), the oil films' forces
+for the samples and the Rosenbrock step (solver.method: rosenbrock; linked into the loop it added ~10 s to a compile
+on an empty cache) as arguments typed as function types (`addressed_kernels`, `compiled_loop`) and passes the
+projection, the dynamics and the films on to the kernels that need them. A run that does not need the Rosenbrock step
+or the films passes a stand-in of the same type instead (`addressed`), so the same compiled loop never compiles them. Each is then compiled once, not into every library above it, and none has to be
 compiled before `advance` is typed, so on an empty cache a second process compiles them meanwhile
 (clearsim/solver/precompile.py). A call by address is not inlined (the slider-crank's loop runs 6–9 % slower,
 the UHV's 2–5 %), so the parts called every step (the event search, the sampling, the peak search, the DOPRI

@@ -22,9 +22,10 @@ with all its callees linked in and optimised again. So five kernels are called b
 the mode switch, the projection, the model's dynamics (forces and constrained accelerations), the oil films' forces
 for the samples and the Rosenbrock step (solver.method: rosenbrock; linked into the loop it added ~10 s to a compile
 on an empty cache) as arguments typed as function types (`addressed_kernels`, `compiled_loop`) and passes the
-projection, the dynamics and the films on to the kernels that need them. A run that does not need the Rosenbrock step
-or the films passes a stand-in of the same type instead (`addressed`), so the same compiled loop never compiles them. Each is then compiled once, not into every library above it, and none has to be
-compiled before `advance` is typed, so on an empty cache a second process compiles them meanwhile
+projection, the dynamics and the films on to the kernels that need them. A run that does not need the Rosenbrock
+step or the films passes a stand-in of the same type instead (`addressed`), so the same compiled loop never
+compiles them. Each is then compiled once, not into every library above it, and none has to be compiled before
+`advance` is typed, so on an empty cache a second process compiles them meanwhile
 (clearsim/solver/precompile.py). A call by address is not inlined (the slider-crank's loop runs 6–9 % slower,
 the UHV's 2–5 %), so the parts called every step (the event search, the sampling, the peak search, the DOPRI
 step) and the scalar helpers stay inlined by numba (inline="always"); kernels called many times per step stay

@@ -114,7 +114,7 @@ def trace(config: Path, overrides: list[str], jacobian_every: int = 0) -> tuple[
 
     system = prepare(load_mechanism(config, overrides))
     run = Run(system)
-    arrays, dynamics = run.kernel_arrays, ig.addressed(ig.DOPRI5)[2]
+    arrays, dynamics = run.kernel_arrays, ig.addressed(ig.DOPRI5, run.lubricated)[2]
     n = system.coordinate_count
     rtol, atol = run.real[ig.R_RTOL], run.real[ig.R_ATOL]
     controlled = np.r_[np.arange(2 * n), np.arange(2 * n + WORK_COUNT, run.y.size - wear_state_count(arrays))]

@@ -22,12 +22,13 @@ from clearsim.assembly.constraints import (
     jacobian_times, jacobian_transpose_times, prescribed, schur_complement,
 )
 from clearsim.assembly.forces import (
-    STICK, add_applied_forces, add_clearance_forces, add_global_force, add_wear_rates, clearance_kinematics, stick_row,
+    STICK, add_applied_forces, add_clearance_forces, add_global_force, add_wear_rates, clearance_kinematics, film_forces,
+    no_film_forces, stick_row,
 )
 from clearsim.assembly.drivelines import add_driveline_forces, driveline_powers
 from clearsim.assembly.hydraulics import add_hydraulic_forces, hydraulic_rates
 from clearsim.assembly.kinematics import point_position
-from clearsim.assembly.arrays import CL_BEARING_POINT, copy_into
+from clearsim.assembly.arrays import CL_BEARING_POINT, CL_VISCOSITY, copy_into
 
 WORK_DRIVER = 0
 WORK_CONTACT = 1
@@ -265,23 +266,67 @@ def driver_power(system, t, lam):
 
 @njit(cache=True)
 def generalized_forces(system, t, q, qd, modes, impact_speeds):
-    """(Q, applied power, damping loss, contact loss, friction loss)."""
+    """(Q, applied power, damping loss, contact loss, friction loss), oil films included."""
+    return model_forces(system, t, q, qd, modes, impact_speeds, True)
+
+
+@njit(cache=True)
+def model_forces(system, t, q, qd, modes, impact_speeds, with_films):
+    """generalized_forces, without the oil films' forces where `with_films` is None (forces.add_clearance_forces)."""
     generalized = np.zeros(q.shape[0])
     applied, damping = add_applied_forces(system, t, q, qd, generalized)
-    contact, friction = add_clearance_forces(system, q, qd, modes, impact_speeds, generalized)
+    contact, friction = add_clearance_forces(system, q, qd, modes, impact_speeds, generalized, with_films)
     add_driveline_forces(system, t, q, qd, generalized)  # their powers: driveline_powers, in rhs
     return generalized, applied, damping, contact, friction
 
 
-@njit(cache=True)
-def forces_and_accelerations(system, t, q, qd, z, modes, impact_speeds):
-    """(q̈, λ, applied power, damping loss, contact loss, friction loss) at (t, q, q̇) and element states z: the model's
-    dynamics, which the loop's kernels call by address (their `dynamics` argument), so it is compiled once, not into
-    each of them."""
-    generalized, applied, damping, contact, friction = generalized_forces(system, t, q, qd, modes, impact_speeds)
+@njit(cache=True, inline="always")
+def model_dynamics(system, t, q, qd, z, modes, impact_speeds, with_films):
+    """(q̈, λ, applied power, damping loss, contact loss, friction loss) at (t, q, q̇) and element states z, with
+    `with_films` as in model_forces (inlined into each of the two dynamics kernels: not a library of its own to be
+    optimised again in theirs)."""
+    generalized, applied, damping, contact, friction = model_forces(system, t, q, qd, modes, impact_speeds,
+                                                                    with_films)
     add_hydraulic_forces(system, q, z, generalized)
     qdd, lam = accelerations(system, t, q, qd, generalized, modes)
     return qdd, lam, applied, damping, contact, friction
+
+
+@njit(cache=True)
+def forces_and_accelerations(system, t, q, qd, z, modes, impact_speeds):
+    """model_dynamics with the oil films: the dynamics of a model with a lubricated joint, which the loop's kernels
+    call by address (their `dynamics` argument), so it is compiled once, not into each of them."""
+    return model_dynamics(system, t, q, qd, z, modes, impact_speeds, True)
+
+
+@njit(cache=True)
+def dry_forces_and_accelerations(system, t, q, qd, z, modes, impact_speeds):
+    """model_dynamics without the oil films: the dynamics of a model that has none, which therefore compiles no film
+    kernel (dynamics_kernel)."""
+    return model_dynamics(system, t, q, qd, z, modes, impact_speeds, None)
+
+
+def dynamics_kernel(lubricated: bool):
+    """The dynamics `advance` takes by address for a model with (lubricated) or without oil films; both of
+    dynamics_type."""
+    return forces_and_accelerations if lubricated else dry_forces_and_accelerations
+
+
+def films_kernel(lubricated: bool):
+    """The oil films' forces the sampling takes by address (samples.derive_sample): film_forces, or its stand-in for a
+    model without oil films; both of films_type."""
+    return film_forces if lubricated else no_film_forces
+
+
+def films_type(system_type):
+    """The numba type of a `films` argument called by address: film_forces' (F_n, F_t, T, ω_J − ω_B)(system, k, q, q̇)."""
+    vector, real = types.float64[::1], types.float64
+    return types.FunctionType(types.Tuple((real, real, real, real))(system_type, types.int64, vector, vector))
+
+
+def has_oil_films(arrays) -> bool:
+    """Whether a joint of these system arrays (SystemArrays) has an oil film (CL_VISCOSITY > 0)."""
+    return bool(np.any(arrays.clearance_params[:, CL_VISCOSITY] > 0.0))
 
 
 def dynamics_type(system_type):

@@ -177,15 +177,18 @@ def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact
 
 
 @njit(cache=True)
-def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized):
-    """Add all contact force pairs; return (contact dissipation power, friction dissipation power)."""
+def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized, with_films):
+    """Add all contact force pairs; return (contact dissipation power, friction dissipation power). `with_films`: True,
+    or None for a model without oil films, whose specialisation numba prunes of the film forces before typing them
+    (dynamics.dynamics_kernel)."""
     contact_loss = 0.0
     friction_loss = 0.0
     for k in range(system.clearance_bodies.shape[0]):
         kinematics = clearance_kinematics(system, k, q, qd)
         ex, ey, dex, dey, penetration, rate, nx, ny, sliding = kinematics
         if modes[k] == FREE and system.clearance_params[k, CL_VISCOSITY] > 0.0:
-            contact_loss += add_film_forces(system, k, q, qd, generalized)
+            if with_films is not None:
+                contact_loss += add_film_forces(system, k, q, qd, generalized)
             continue
         fn, ft, elastic = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], impact_speeds[k])
         contact_loss += (fn - elastic) * rate  # also while the damping term clips F_n to 0 with δ > 0
@@ -269,6 +272,14 @@ def film_forces(system, k, q, qd):
                         p[CL_FILM_LENGTH], p[CL_CLEARANCE], eps, eps_rate, wedge)
     torque = film_torque(p[CL_VISCOSITY], p[CL_JOURNAL_RADIUS], p[CL_FILM_LENGTH], p[CL_CLEARANCE], eps, spin)
     return fn, ft, torque, spin
+
+
+@njit(cache=True)
+def no_film_forces(system, k, q, qd):
+    """film_forces' stand-in, of its type, in the sampling of a model in which no joint has an oil film (CL_VISCOSITY
+    0), which never calls it: such a model does not compile the film kernels (physics/lubrication.py;
+    integrator.addressed)."""
+    return 0.0, 0.0, 0.0, 0.0
 
 
 @njit(cache=True)

@@ -189,10 +189,12 @@ def liu_energy(penetration, line_stiffness, clearance):
 # --- one law, chosen per joint --------------------------------------------------------------------------------
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def law_state(law, penetration, stiffness, exponent, clearance):
     """(F_el, dF_el/dδ, ∫₀^δ F_el) of elastic law `law` (ELASTIC_LAWS) with the joint's K, n, ΔR (module
-    docstring); zeros for δ ≤ 0. The power laws: K δⁿ, n K δⁿ⁻¹, K δⁿ⁺¹/(n + 1)."""
+    docstring); zeros for δ ≤ 0. The power laws: K δⁿ, n K δⁿ⁻¹, K δⁿ⁺¹/(n + 1). A kernel of its own, not inlined by
+    numba into its four call sites (each typed and lowered every law again: ~3 s of a compile on an empty cache; the
+    loop's run time is the same within its noise, docs/performance.md)."""
     if penetration <= 0.0:
         return 0.0, 0.0, 0.0
     if law == LIU:

@@ -18,12 +18,14 @@ Python (progress bar, writing, Ctrl-C); all its state lives in the arrays of `Ru
 at the top of the loop changes no result (tested with a return every 7 steps: every result file bitwise equal).
 
 Compile time (docs/performance.md): numba compiles every kernel it calls as a library of its own,
-with all its callees linked in and optimised again. So four kernels are called by address: `advance` takes
-the mode switch, the projection, the model's dynamics (forces and constrained accelerations) and the Rosenbrock
-step (solver.method: rosenbrock; linked into the loop it added ~10 s to a compile on an empty cache) as arguments
-typed as function types (`addressed_kernels`, `compiled_loop`) and passes the projection and the dynamics on to
-the kernels that need them. Each is then compiled once, not into every library above it, and none has to be
-compiled before `advance` is typed, so on an empty cache a second process compiles them meanwhile
+with all its callees linked in and optimised again. So five kernels are called by address: `advance` takes
+the mode switch, the projection, the model's dynamics (forces and constrained accelerations), the oil films' forces
+for the samples and the Rosenbrock step (solver.method: rosenbrock; linked into the loop it added ~10 s to a compile
+on an empty cache) as arguments typed as function types (`addressed_kernels`, `compiled_loop`) and passes the
+projection, the dynamics and the films on to the kernels that need them. A run that does not need the Rosenbrock
+step or the films passes a stand-in of the same type instead (`addressed`), so the same compiled loop never
+compiles them. Each is then compiled once, not into every library above it, and none has to be compiled before
+`advance` is typed, so on an empty cache a second process compiles them meanwhile
 (clearsim/solver/precompile.py). A call by address is not inlined (the slider-crank's loop runs 6–9 % slower,
 the UHV's 2–5 %), so the parts called every step (the event search, the sampling, the peak search, the DOPRI
 step) and the scalar helpers stay inlined by numba (inline="always"); kernels called many times per step stay
@@ -39,8 +41,9 @@ from clearsim.assembly.arrays import (
     CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_STIFFNESS, copy_into,
 )
 from clearsim.assembly.dynamics import (
-    WORK_COUNT, coordinate_count, dynamics_type, effective_mass, element_states, forces_and_accelerations,
-    project_positions, project_velocities, rhs, stick_row_index, wear_state_count,
+    WORK_COUNT, coordinate_count, dry_forces_and_accelerations, dynamics_kernel, dynamics_type, effective_mass,
+    element_states, films_kernel, films_type, forces_and_accelerations, project_positions, project_velocities, rhs,
+    stick_row_index, wear_state_count,
 )
 from clearsim.assembly.forces import (
     CONTACT, FREE, SLIDE_BACK, STICK, clearance_kinematics, contact_force_magnitudes, exact_stick,
@@ -241,7 +244,7 @@ def projection_type(system_type):
 
 
 @njit(cache=True, inline="always")
-def emit_samples(system, dynamics, projection, implicit_step, t, y, f, stages, h, t_next, modes, speeds, episode_of,
+def emit_samples(system, dynamics, films, projection, implicit_step, t, y, f, stages, h, t_next, modes, speeds, episode_of,
                  real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact,
                  out_energies, scratch):
     """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives
@@ -270,7 +273,7 @@ def emit_samples(system, dynamics, projection, implicit_step, t, y, f, stages, h
         copy_into(out_modes[row], modes)
         copy_into(out_speeds[row], speeds)
         copy_into(out_episode[row], episode_of)
-        derive_sample(system, dynamics, sample_time, scratch, modes, speeds, out_qdd[row], out_lam[row],
+        derive_sample(system, dynamics, films, sample_time, scratch, modes, speeds, out_qdd[row], out_lam[row],
                       out_contact[row], out_energies[row])
         if chained:
             origin_t, origin_y, origin_f = sample_time, scratch.copy(), np.empty_like(f)
@@ -529,7 +532,7 @@ def refine_event(system, dynamics, projection, implicit_step, k, kind, t, y, f, 
 
 
 @njit(cache=True)
-def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real, ints, modes, speeds, episode_of, log_joint,
+def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, f, real, ints, modes, speeds, episode_of, log_joint,
             log_onset, log_loss, log_speed, log_mass, peak_force, jacobian, jacobian_modes, out_t, out_y, out_modes,
             out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, t_stop):
     """Integrate until t_stop, the end, a full buffer, STEPS_PER_CALL tried steps or a failure; the status is
@@ -571,7 +574,7 @@ def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real
             ints[I_RHS] += 1
             real[R_STEP] = min(real[R_STEP], switched)
         if ints[I_NEXT_SAMPLE] == 0:  # the first sample, in the modes the initial state has
-            emit_samples(system, dynamics, projection, implicit_step, t, y, f, stages, 0.0, t, modes, speeds,
+            emit_samples(system, dynamics, films, projection, implicit_step, t, y, f, stages, 0.0, t, modes, speeds,
                          episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
                          scratch)
         h = min(real[R_STEP], real[R_MAX_STEP], real[R_T_END] - t, free_flight_limit(system, y, modes))
@@ -608,7 +611,7 @@ def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real
             h = refine_event(system, dynamics, projection, implicit_step, event_joint, event_kind, t, y, f,
                              event_theta * h, modes, speeds, stages, y_new, real, ints, jacobian, jacobian_modes)
             fill_subdivisions(y, stages, h, points)  # the step integrated again, to the event
-        emit_samples(system, dynamics, projection, implicit_step, t, y, f, stages, h, t + h, modes, speeds,
+        emit_samples(system, dynamics, films, projection, implicit_step, t, y, f, stages, h, t + h, modes, speeds,
                      episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
                      scratch)
         if event_joint < 0:  # projected after the samples: the step end's factor then serves its rhs below
@@ -643,15 +646,17 @@ def advance(system, mode_switch, projection, dynamics, implicit_step, y, f, real
         update_output_peak(n, y, f, real)
 
 
-def addressed(method: int) -> tuple:
-    """The kernels `advance` takes by address for a run of `method` (DOPRI5, ROSENBROCK), in its argument order: the
-    Rosenbrock step where it is the method, else its stand-in of the same type (rosenbrock.not_taken, never called),
-    so that only a run that takes the Rosenbrock step compiles it. Both give `advance` the same type."""
+def addressed(method: int, lubricated: bool) -> tuple:
+    """The kernels `advance` takes by address for a run of `method` (DOPRI5, ROSENBROCK) of a model with or without
+    oil films (`lubricated`, dynamics.has_oil_films), in its argument order: the Rosenbrock step where it is the
+    method, else its stand-in of the same type (rosenbrock.not_taken, never called), so that only a run that takes the
+    Rosenbrock step compiles it; likewise the dynamics and the sampling's film forces compile the oil films' kernels
+    only for a lubricated model (dynamics_kernel, films_kernel). Every choice gives `advance` the same type."""
     step_kernel = rosenbrock.attempt if method == ROSENBROCK else rosenbrock.not_taken
-    return (switch_mode, project_state, forces_and_accelerations, step_kernel)
+    return (switch_mode, project_state, dynamics_kernel(lubricated), films_kernel(lubricated), step_kernel)
 
 
-def addressed_kernels(system_type, method: int) -> list:
+def addressed_kernels(system_type, method: int, lubricated: bool) -> list:
     """(kernel, numba function type) of each kernel `advance` takes by address, in its argument order.
 
     A kernel called by address is compiled once, as a library of its own, instead of being linked into (and
@@ -668,13 +673,17 @@ def addressed_kernels(system_type, method: int) -> list:
         switch_mode: F(system_type, dynamics, projection, I, I, F, V, IV, V, IV, V, IV, IV, V, V, V, V),
         project_state: projection.signature,
         forces_and_accelerations: dynamics.signature,
+        dry_forces_and_accelerations: dynamics.signature,
+        films_kernel(True): films_type(system_type).signature,
+        films_kernel(False): films_type(system_type).signature,
     }
-    return [(kernel, types.FunctionType(signature[kernel])) for kernel in addressed(method)]
+    return [(kernel, types.FunctionType(signature[kernel])) for kernel in addressed(method, lubricated)]
 
 
-def loop_arguments(system, method: int, *state):
-    """advance's arguments for a system's kernel arrays, the run's method and its state arrays (and t_stop)."""
-    return (system, *addressed(method), *state)
+def loop_arguments(system, method: int, lubricated: bool, *state):
+    """advance's arguments for a system's kernel arrays, the run's method, whether its model has oil films and its
+    state arrays (and t_stop)."""
+    return (system, *addressed(method, lubricated), *state)
 
 
 def compiled_loop(arguments: tuple):
@@ -683,8 +692,8 @@ def compiled_loop(arguments: tuple):
     compiled for it, so arguments of other types fail instead of compiling a second loop that links them in."""
     global _loop_ready
     if not _loop_ready:
-        kinds = {id(kernel): kind for method in METHODS.values() for kernel, kind in addressed_kernels(
-            typeof(arguments[0]), method)}
+        kinds = {id(kernel): kind for method in METHODS.values() for lubricated in (False, True)
+                 for kernel, kind in addressed_kernels(typeof(arguments[0]), method, lubricated)}
         advance.compile(tuple(kinds.get(id(value)) or typeof(value) for value in arguments))
         advance.disable_compile()
         _loop_ready = True

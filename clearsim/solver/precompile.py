@@ -2,11 +2,11 @@
 
 numba compiles in one thread per process. A run compiles the assembly's kernels, then `advance`, then, at the
 loop's first call, the kernels `advance` takes by address (integrator.addressed_kernels: the mode switch, the
-projection, the dynamics), one after the other in its argument order. When the cache holds no `advance`, the first
+projection, the dynamics, the films' forces), one after the other in its argument order. When the cache holds no `advance`, the first
 run (`prepare`) starts `python -m clearsim.solver.precompile`, which compiles into the same cache the kernels the
-run's typing of `advance` needs early (`AHEAD`) and then those taken by address (an explicit run's: the Rosenbrock
-step's stand-in; a Rosenbrock run compiles its step itself) in the reverse order, the largest
-first (`kernels_ahead`). When the run reaches a kernel
+run's typing of `advance` needs early (`AHEAD`) and then those taken by address in the reverse order, the largest
+first (`kernels_ahead`): an explicit run's of a model without oil films (with the stand-ins of the Rosenbrock step and
+of the films; a Rosenbrock run compiles its step itself, a lubricated model its dynamics and films). When the run reaches a kernel
 the helper has already written, numba loads it from the cache instead of compiling it (the same machine code: the
 cache is keyed by the sources and the signature), so the two processes meet in the middle of that list. Where they
 meet, the run waits for the kernel the helper is compiling at that moment (the helper names it in BUSY_NAME) and
@@ -33,7 +33,7 @@ from numba import typeof, types
 from numba.core import config
 
 from clearsim.assembly.arrays import KernelArraysType, blas_hidden
-from clearsim.assembly.dynamics import dynamics_type
+from clearsim.assembly.dynamics import dynamics_type, films_type
 from clearsim.solver.integrator import DOPRI5, addressed_kernels, advance
 
 LOCK_NAME = "compile-ahead.lock"
@@ -45,13 +45,14 @@ DISABLE_VARIABLE = "CLEARSIM_COMPILE_AHEAD"
 F, I = types.float64, types.int64
 V, IV, M = types.float64[::1], types.int64[::1], types.float64[:, ::1]
 D = object()  # stands for dynamics_type(system_type()) in AHEAD
+FILMS = object()  # stands for films_type(system_type())
 
 # (module, kernel, argument types after the system): what the helper compiles first, in this order: the kernels the
 # run's typing of `advance` reaches soon after the assembly's kernels (the event function, the sampling, the event
 # search, the peak search). Then come the kernels `advance` takes by address (kernels_ahead).
 AHEAD = (
     ("clearsim.solver.integrator", "event_value", (D, I, I, F, V, IV, V)),
-    ("clearsim.solver.samples", "derive_sample", (D, F, V, IV, V, V, V, M, V)),
+    ("clearsim.solver.samples", "derive_sample", (D, FILMS, F, V, IV, V, V, V, M, V)),
     ("clearsim.solver.integrator", "_value_at", (D, I, I, F, V, M, F, F, IV, V, V)),
     ("clearsim.solver.integrator", "normal_force_at", (I, V, M, F, F, IV, V, V)),
 )
@@ -94,11 +95,11 @@ def kernels_ahead():
     (so that the two processes meet in the middle), by their function types' signatures (numba compiles, and keys in
     the cache, a kernel called by address by its signature with the return type)."""
     system = system_type()
-    dynamics = dynamics_type(system)
+    stands_for = {id(D): dynamics_type(system), id(FILMS): films_type(system)}
     ahead = [(getattr(importlib.import_module(module), name),
-              (system, *(dynamics if argument is D else argument for argument in arguments)))
+              (system, *(stands_for.get(id(argument), argument) for argument in arguments)))
              for module, name, arguments in AHEAD]
-    return ahead + [(kernel, kind.signature) for kernel, kind in reversed(addressed_kernels(system, DOPRI5))]
+    return ahead + [(kernel, kind.signature) for kernel, kind in reversed(addressed_kernels(system, DOPRI5, False))]
 
 
 def cache_is_cold() -> bool:
@@ -198,19 +199,19 @@ def wait_while_helper_compiles(kernel) -> float:
     return time.monotonic() - started
 
 
-_addressed_ready: set[int] = set()  # the methods whose kernels this process has compiled or loaded
+_addressed_ready: set[tuple] = set()  # the (method, lubricated) whose kernels this process has compiled or loaded
 
 
-def compile_addressed(kernel_arrays, method: int) -> None:
+def compile_addressed(kernel_arrays, method: int, lubricated: bool) -> None:
     """Before the loop's first call in a process: each kernel `advance` takes by address compiled here, or loaded from
     the cache, in advance's argument order, as the call would convert them — except that one the helper is compiling
     at that moment is waited for and loaded, not compiled by both processes (where the two meet in the middle)."""
-    if method in _addressed_ready:
+    if (method, lubricated) in _addressed_ready:
         return
-    for kernel, kind in addressed_kernels(typeof(kernel_arrays), method):
+    for kernel, kind in addressed_kernels(typeof(kernel_arrays), method, lubricated):
         wait_while_helper_compiles(kernel)
         kernel.compile(kind.signature)
-    _addressed_ready.add(method)
+    _addressed_ready.add((method, lubricated))
 
 
 if __name__ == "__main__":

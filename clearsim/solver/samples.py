@@ -12,9 +12,7 @@ from clearsim.assembly.constraints import constraint_count
 from clearsim.assembly.dynamics import (
     constraint_violation, coordinate_count, element_states, stick_row_index,
 )
-from clearsim.assembly.forces import (
-    FREE, STICK, clearance_kinematics, contact_force_magnitudes, film_forces, potential_energy,
-)
+from clearsim.assembly.forces import FREE, STICK, clearance_kinematics, contact_force_magnitudes, potential_energy
 
 # columns of the per-joint contact output; the film's (a lubricated joint's oil film, zero while the dry laws act)
 C_ECC_X, C_ECC_Y, C_PENETRATION, C_RATE, C_NORMAL, C_FRICTION, C_SLIDING = range(7)
@@ -25,9 +23,9 @@ ENERGY_FIELDS = 3
 
 
 @njit(cache=True)
-def derive_sample(system, dynamics, t, state, modes, speeds, qdd, lam, contact, energies):
+def derive_sample(system, dynamics, films, t, state, modes, speeds, qdd, lam, contact, energies):
     """One sample's q̈ and λ into qdd and lam, its contact fields (nc, CONTACT_FIELDS) into contact, and (kinetic,
-    potential, violation) into energies."""
+    potential, violation) into energies; `films` the oil films' forces, by address (dynamics.films_kernel)."""
     n = coordinate_count(system)
     m = constraint_count(system)
     q = state[:n].copy()
@@ -46,7 +44,7 @@ def derive_sample(system, dynamics, t, state, modes, speeds, qdd, lam, contact, 
         film_active = modes[k] == FREE and system.clearance_params[k, CL_VISCOSITY] > 0.0
         fields[C_FILM_RADIAL], fields[C_FILM_TANGENTIAL] = 0.0, 0.0
         if film_active:
-            fields[C_FILM_RADIAL], fields[C_FILM_TANGENTIAL] = film_forces(system, k, q, qd)[:2]
+            fields[C_FILM_RADIAL], fields[C_FILM_TANGENTIAL] = films(system, k, q, qd)[:2]
         fields[C_FILM_THICKNESS] = system.clearance_params[k, CL_CLEARANCE] - (ex * ex + ey * ey) ** 0.5
         fields[C_FILM_ACTIVE] = 1.0 if film_active else 0.0
     kinetic = 0.0

@@ -17,7 +17,7 @@ import numpy as np
 from clearsim.assembly.arrays import CL_BEARING_RADIUS, CL_MU_D, CL_MU_S, CL_STIFFNESS, for_kernels
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints
 from clearsim.assembly.drivelines import puffer_overrun
-from clearsim.assembly.dynamics import WORK_COUNT
+from clearsim.assembly.dynamics import WORK_COUNT, has_oil_films
 from clearsim.assembly.forces import FREE
 from clearsim.assembly.system import System
 from clearsim.errors import SolverError
@@ -215,6 +215,7 @@ class Run:
         settings = system.mechanism.solver
         arrays = system.arrays
         self.kernel_arrays = for_kernels(arrays)
+        self.lubricated = has_oil_films(arrays)  # which dynamics the loop takes (integrator.addressed)
         nc = len(system.clearance_joints)
         n = system.coordinate_count
         self.y = np.concatenate([system.q0, system.qd0, np.zeros(WORK_COUNT), system.z0])
@@ -249,9 +250,10 @@ class Run:
         # compiled rhs from Python instead would load a second copy of the dynamics (docs/performance.md)
         self.wall_time = 0.0
         self.kernel_time = 0.0
-        # the loop, or the Rosenbrock step only a Rosenbrock run compiles (integrator.addressed), is not in the cache
-        self.kernels_compiled = precompile.cache_is_cold() or (
-            settings.method == "rosenbrock" and precompile.not_cached(ig.addressed(ig.ROSENBROCK)[-1]))
+        # the loop, or a kernel it takes by address for this method and model (integrator.addressed: the Rosenbrock
+        # step, the oil films' dynamics), is not in the cache
+        self.kernels_compiled = precompile.cache_is_cold() or any(
+            precompile.not_cached(kernel) for kernel in ig.addressed(int(self.ints[ig.I_METHOD]), self.lubricated))
         self.coordinate_count = n
         self.watched = (0, 0.0)  # tried steps and time where the stretch being watched began (judge_pace)
         self.pace_warnings: list[str] = []
@@ -299,11 +301,11 @@ class Run:
     def _advance(self, t_stop: float) -> None:
         started = clock.perf_counter()
         method = int(self.ints[ig.I_METHOD])
-        arguments = ig.loop_arguments(self.kernel_arrays, method, self.y, self.f, self.real, self.ints, self.modes, self.speeds,
-                                      self.episode_of, *self.log, self.peak_force, self.jacobian, self.jacobian_modes,
-                                      *self.buffers, t_stop)
+        arguments = ig.loop_arguments(self.kernel_arrays, method, self.lubricated, self.y, self.f, self.real, self.ints,
+                                      self.modes, self.speeds, self.episode_of, *self.log, self.peak_force, self.jacobian,
+                                      self.jacobian_modes, *self.buffers, t_stop)
         loop = ig.compiled_loop(arguments)
-        precompile.compile_addressed(self.kernel_arrays, method)  # once per process and method, before its first call
+        precompile.compile_addressed(self.kernel_arrays, method, self.lubricated)  # once per process, before a first call
         loop(*arguments)
         if self.ints[ig.I_STATUS] == ig.FIRST_STEP:  # the first call: loads (or compiles) the loop, one rhs
             self.kernel_time += clock.perf_counter() - started

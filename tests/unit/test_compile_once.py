@@ -22,6 +22,8 @@ from clearsim.solver.precompile import DISABLE_VARIABLE, kernels_ahead
 
 ROOT = Path(__file__).resolve().parents[2]
 CRANK = BUNDLED_CONFIG.parent / "slider_crank_flores.yaml"
+LUBRICATED = ("defaults.lubrication.viscosity=0.1Pa*s", "defaults.lubrication.length=50mm", "solver.t_end=0.2ms")
+FILM_KERNELS = ("clearsim.assembly.forces.film_forces", "clearsim.physics.lubrication.film_force")
 SCRIPT = """
 import collections, sys
 from numba.core import event
@@ -69,10 +71,17 @@ def test_helper_then_run_compile_every_kernel_once_with_the_same_results(tmp_pat
     assert sorted(by_helper.keys() & by_run.keys()) == []  # the run loaded all the helper wrote
     step = "clearsim.solver.rosenbrock.attempt"
     assert step not in by_helper and step not in by_run  # an explicit run compiles no Rosenbrock step (its stand-in)
+    assert [name for name in FILM_KERNELS if name in by_helper or name in by_run] == []  # a dry model: no film kernel
     _, by_implicit = _compiled(env, CRANK, tmp_path / "implicit.h5", "solver.method=rosenbrock")
     assert by_implicit.get(step) == 1 and "clearsim.solver.integrator.advance" not in by_implicit  # the same loop
     with h5py.File(tmp_path / "implicit.h5") as implicit:
         assert bool(implicit.attrs["kernels_compiled"])  # its step was compiled: the run says so
+    _, by_lubricated = _compiled(env, CRANK, tmp_path / "lubricated.h5", *LUBRICATED)
+    assert all(by_lubricated.get(name) == 1 for name in FILM_KERNELS)  # a model with oil films compiles them
+    assert [name for name, count in by_lubricated.items() if count > 1] == []
+    assert "clearsim.solver.integrator.advance" not in by_lubricated  # in the same loop
+    with h5py.File(tmp_path / "lubricated.h5") as lubricated:
+        assert bool(lubricated.attrs["kernels_compiled"])
 
     simulate_config(BUNDLED_CONFIG, ["solver.t_end=1ms"], tmp_path / "suite-cache-filled.h5")  # compiles if cold
     simulate_config(BUNDLED_CONFIG, ["solver.t_end=1ms"], tmp_path / "suite-cache.h5")

@@ -21,7 +21,7 @@ def test_advance_has_one_specialisation_taking_its_kernels_as_addresses(tmp_path
     simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")
     (signature,) = integrator.advance.signatures
     system_type = typeof(for_kernels(prepare(load_mechanism(CRANK, [])).arrays))
-    addressed = integrator.addressed_kernels(system_type, integrator.DOPRI5)
+    addressed = integrator.addressed_kernels(system_type, integrator.DOPRI5, False)
     assert signature[0] == system_type
     assert {dynamics_type(system_type), integrator.projection_type(system_type)} <= set(signature)
     assert list(signature[1:1 + len(addressed)]) == [kind for _, kind in addressed]
@@ -38,9 +38,10 @@ def _values_of(signature_types):
 def test_advance_refuses_arguments_of_another_type_instead_of_compiling_them(tmp_path):
     simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")
     (signature,) = integrator.advance.signatures
-    state = _values_of(signature[1 + len(integrator.addressed_kernels(signature[0], integrator.DOPRI5)):])
+    state = _values_of(signature[1 + len(integrator.addressed_kernels(signature[0], integrator.DOPRI5, False)):])
     state[0] = state[0].astype(np.float32)  # y of another dtype
-    arguments = integrator.loop_arguments(for_kernels(prepare(load_mechanism(CRANK, [])).arrays), integrator.DOPRI5, *state)
+    arguments = integrator.loop_arguments(for_kernels(prepare(load_mechanism(CRANK, [])).arrays), integrator.DOPRI5, False,
+                                          *state)
     assert len(arguments) == len(signature)
     with pytest.raises(TypeError):
         integrator.compiled_loop(arguments)(*arguments)

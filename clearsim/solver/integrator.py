@@ -69,9 +69,10 @@ REAL_SLOTS = 17
 # the integration method (METHODS) and, for ROSENBROCK, the accepted steps its Jacobian has served (−1: none yet, or
 # one to take anew: rosenbrock.jacobian_is_stale)
 I_METHOD, I_JACOBIAN_AGE = 14, 15
-# solver.band_ends: located: a rejected try across an end of a sliding joint's friction band is tried again up to it (1)
-I_BAND_END_STEPS = 16
-INT_SLOTS = 17
+# solver.band_ends: located: a rejected try across an end of a sliding joint's friction band is tried again up to it (1);
+# the tries so shortened
+I_BAND_END_STEPS, I_BAND_END_TRIES = 16, 17
+INT_SLOTS = 18
 DOPRI5, ROSENBROCK, DOP853 = range(3)
 METHODS = {"dopri5": DOPRI5, "rosenbrock": ROSENBROCK, "dop853": DOP853}
 
@@ -592,7 +593,10 @@ def band_end_step(system, dynamics, t, y, y_new, stages, h, points, modes, speed
     for k in range(modes.shape[0]):
         theta = min(theta, first_event(system, dynamics, k, BAND_END, t, y, y_new, stages, h, points, modes, speeds,
                                        scratch))
-    return min(theta * h, suggested) if BAND_END_MARGIN < theta < 1.0 else suggested
+    if not BAND_END_MARGIN < theta < 1.0 or theta * h >= suggested:
+        return suggested
+    ints[I_BAND_END_TRIES] += 1
+    return theta * h
 
 
 @njit(cache=True)

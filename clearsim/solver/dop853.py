@@ -240,24 +240,25 @@ def _dense_weights() -> np.ndarray:
 DENSE = _dense_weights()
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new):
     """One DOP853 step from (t, y) with ẏ(t) = f: fills stages[:12] and y_new; returns the 5th- and 3rd-order error
     vectors (combined_norm)."""
     copy_into(stages[0], f)
-    evaluate_stages(system, dynamics, t, y, h, modes, speeds, stages, A, C, 1, N_STAGES)
-    accumulate(y_new, y, B, h, stages, N_STAGES)
+    # counts from the tables' shapes (int64), not the module's integers (each literal would compile the callee again)
+    evaluate_stages(system, dynamics, t, y, h, modes, speeds, stages, A, C, np.int64(1), B.shape[0])
+    accumulate(y_new, y, B, h, stages, B.shape[0])
     high = np.zeros_like(y)
-    accumulate(high, high, E5, h, stages, N_STAGES)
+    accumulate(high, high, E5, h, stages, B.shape[0])
     low = np.zeros_like(y)
-    accumulate(low, low, E3, h, stages, N_STAGES)
+    accumulate(low, low, E3, h, stages, B.shape[0])
     return high, low
 
 
 @njit(cache=True)
 def extend(system, dynamics, t, y, h, modes, speeds, stages):
     """The continuous extension's stages of a step taken (f at its end and three more, stages[12:16])."""
-    evaluate_stages(system, dynamics, t, y, h, modes, speeds, stages, A, C, N_STAGES, STAGES)
+    evaluate_stages(system, dynamics, t, y, h, modes, speeds, stages, A, C, B.shape[0], A.shape[0])
 
 
 @njit(cache=True)

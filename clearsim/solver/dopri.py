@@ -62,7 +62,7 @@ def evaluate_stages(system, dynamics, t, y, h, modes, speeds, stages, matrix, no
 def step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new):
     """One DOPRI5 step from (t, y) with ẏ(t) = f; fills stages (7, ny) and y_new; returns the error vector."""
     copy_into(stages[0], f)
-    evaluate_stages(system, dynamics, t, y, h, modes, speeds, stages, MATRIX, NODES, 1, 6)
+    evaluate_stages(system, dynamics, t, y, h, modes, speeds, stages, MATRIX, NODES, np.int64(1), MATRIX.shape[0])
     accumulate(y_new, y, WEIGHTS, h, stages, WEIGHTS.shape[0])
     rhs(system, dynamics, np.nextafter(t + h, t), y_new, modes, speeds, stages[6])
     error = np.zeros_like(y)

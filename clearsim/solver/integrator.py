@@ -580,19 +580,19 @@ def band_end_step(system, dynamics, t, y, y_new, stages, h, points, modes, speed
     a sliding joint's friction band (a kink of μ(v_t)) where the try crossed one between its ends, located on the
     try's continuous extension. (Up to the band end however long: 6 554 steps and 1 807 rejected on the bundled
     breaker, against 6 442 and 1 653 without; so never longer than the controller's.)"""
+    kind = np.int64(BAND_END)  # int64, as the other kinds: a literal would compile each callee once more for it
     crossed = False
     for k in range(modes.shape[0]):
-        start = event_value(system, dynamics, k, BAND_END, t, y, modes, speeds)[0]
-        end = event_value(system, dynamics, k, BAND_END, t + h, y_new, modes, speeds)[0]
-        crossed = crossed or _crossed(modes[k], BAND_END, start, end)
+        start = event_value(system, dynamics, k, kind, t, y, modes, speeds)[0]
+        end = event_value(system, dynamics, k, kind, t + h, y_new, modes, speeds)[0]
+        crossed = crossed or _crossed(modes[k], kind, start, end)
     if not crossed:
         return suggested
     ints[I_RHS] += extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints)
     fill_subdivisions(y, stages, h, points)
     theta = 2.0
     for k in range(modes.shape[0]):
-        theta = min(theta, first_event(system, dynamics, k, BAND_END, t, y, y_new, stages, h, points, modes, speeds,
-                                       scratch))
+        theta = min(theta, first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, modes, speeds, scratch))
     if not BAND_END_MARGIN < theta < 1.0 or theta * h >= suggested:
         return suggested
     ints[I_BAND_END_TRIES] += 1

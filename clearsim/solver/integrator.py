@@ -1,4 +1,5 @@
-"""The compiled integration loop: adaptive DOPRI5 steps, contact events, fixed-rate samples.
+"""The compiled integration loop: adaptive steps of the run's method (DOPRI5, DOP853 or Rosenbrock), contact events,
+fixed-rate samples.
 
 Each clearance joint has a mode (free / contact) that is constant within a step, so every
 step integrates a smooth right-hand side. Contact onset (δ rising through 0) and loss (δ

@@ -46,7 +46,7 @@ def accumulate(out, base, coefficients, h, stages, count):
                 out[i] += weight * stages[j, i]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def evaluate_stages(system, dynamics, t, y, h, modes, speeds, stages, matrix, nodes, first, last):
     """stages[s] = f(t + c_s h, y + h Σ_{j<s} a_sj K_j) for s = first … last − 1 (an explicit tableau's rows)."""
     work = np.empty_like(y)
@@ -90,10 +90,11 @@ def error_norm(error, y, y_new, count, skipped, tail, rtol, atol):
     return np.sqrt(total / (y.shape[0] - skipped - tail))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def dense_output(y, stages, dense, h, theta, out):
     """y(t + θh) = y + h Σ_j K_j Σ_p dense_jp θ^(p+1) into out (one pass, no temporaries; each element sums its stages
-    in order): the continuous extension of a method whose stage weights are the polynomials of `dense`."""
+    in order): the continuous extension of a method whose stage weights are the polynomials of `dense`. Inlined, so
+    that a method's own table is a constant there, its loops of known length (as fast as a loop written for it)."""
     weights = np.empty(dense.shape[0])
     for j in range(dense.shape[0]):
         weight = 0.0

@@ -151,7 +151,10 @@ def event_value(system, dynamics, k, kind, t, y, modes, speeds):
 def interpolate(y, stages, h, theta, out):
     """The step's continuous extension y(t + θh) into out; the rows of `stages` name the method's: DOP853's 16, else
     DOPRI5's 7 (in whose form the Rosenbrock steps write theirs)."""
-    dense_output(y, stages, dop853.DENSE if stages.shape[0] == dop853.STAGES else DENSE, h, theta, out)
+    if stages.shape[0] == dop853.STAGES:
+        dense_output(y, stages, dop853.DENSE, h, theta, out)
+    else:
+        dense_output(y, stages, DENSE, h, theta, out)
 
 
 @njit(cache=True, inline="always")

@@ -98,15 +98,6 @@ def sliding_coefficient(law, speed, mu_s, mu_d, v_low, v_high):
 
 
 @njit(cache=True, inline="always")
-def band_end_value(law, speed, v_low, v_high):
-    """(|v_t| − v_low)(|v_t| − v_high) for the laws whose μ has a kink at each end of its band (stiction_step: C¹ at
-    v_s and v_d; ambrosio: C⁰ at v_0 and v_1), which changes sign as |v_t| crosses either end; 1.0 for the others."""
-    if law == STICTION_STEP or law == AMBROSIO:
-        return (speed - v_low) * (speed - v_high)
-    return 1.0
-
-
-@njit(cache=True, inline="always")
 def static_coefficient(law, mu_s, mu_d):
     """Largest |F_t|/F_n a sticking contact holds: μ_s (stiction_step), μ_d (coulomb), 0 otherwise."""
     if law == STICTION_STEP:

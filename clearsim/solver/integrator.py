@@ -39,8 +39,7 @@ import numpy as np
 from numba import njit, typeof, types
 
 from clearsim.assembly.arrays import (
-    CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_STIFFNESS, CL_V_HIGH,
-    CL_V_LOW, copy_into,
+    CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_STIFFNESS, copy_into,
 )
 from clearsim.assembly.dynamics import (
     WORK_COUNT, coordinate_count, dry_forces_and_accelerations, dynamics_kernel, dynamics_type, effective_mass,
@@ -52,7 +51,7 @@ from clearsim.assembly.forces import (
 )
 from clearsim.physics.contact import HERTZ_CONTACT_TIME_FACTOR
 from clearsim.physics.cylindrical import is_power_law, law_max_penetration
-from clearsim.physics.friction import band_end_value, static_coefficient
+from clearsim.physics.friction import static_coefficient
 from clearsim.solver import dop853, rosenbrock
 from clearsim.solver.dopri import DENSE, STAGES, dense_output, error_norm, step
 from clearsim.solver.samples import derive_sample
@@ -70,10 +69,7 @@ REAL_SLOTS = 17
 # the integration method (METHODS) and, for ROSENBROCK, the accepted steps its Jacobian has served (−1: none yet, or
 # one to take anew: rosenbrock.jacobian_is_stale)
 I_METHOD, I_JACOBIAN_AGE = 14, 15
-# solver.band_ends: located: a rejected try across an end of a sliding joint's friction band is tried again up to it (1);
-# the tries so shortened
-I_BAND_END_STEPS, I_BAND_END_TRIES = 16, 17
-INT_SLOTS = 18
+INT_SLOTS = 16
 DOPRI5, ROSENBROCK, DOP853 = range(3)
 METHODS = {"dopri5": DOPRI5, "rosenbrock": ROSENBROCK, "dop853": DOP853}
 
@@ -91,8 +87,6 @@ SAFETY = 0.9
 PEAK_CANDIDATE = 0.9  # a step's sampled F_n maximum within 10 % of the peak so far is refined
 PEAK_RESOLUTION = 1e-5  # of the step: the peak's location error; F_n is flat there, so its error is ~1e-10
 NORMAL, TANGENTIAL = 0, 1  # the two event functions of a clearance joint
-BAND_END = 2  # a kink of the friction law (band_end_step): it ends a step, switches no mode
-BAND_END_MARGIN = 0.05  # of a rejected try: a band end closer to its start is not the kink that failed it
 SLIDE_HYSTERESIS = 1e-9  # m/s: ε_v of the sliding-stops event, far below any resolved sliding speed
 DECIDE_SPEED = 1e-6  # m/s: below it a contact tests whether it sticks (settle_friction)
 DEEPEST_PENETRATION = 0.05  # of the journal radius: beyond it no contact law means anything
@@ -125,16 +119,9 @@ def event_value(system, dynamics, k, kind, t, y, modes, speeds):
     NORMAL: δ in free flight (onset at g ↑ 0), δ + ε in contact (loss at g ↓ 0).
     TANGENTIAL (exact-stick laws in contact): μ_s F_n − |F_t| while sticking (slip at g ↓ 0),
     s v_t + ε_v while sliding in direction s (the sliding stops or reverses at g ↓ 0).
-    BAND_END (sliding contact): friction.band_end_value, through 0 either way at an end of the law's band.
     """
     n = coordinate_count(system)
     mode = modes[k]
-    if kind == BAND_END:
-        if mode == FREE or mode == STICK:
-            return 1.0, 0.0
-        p = system.clearance_params[k]
-        speed = abs(clearance_kinematics(system, k, y[:n], y[n:2 * n])[8])
-        return band_end_value(system.clearance_laws[k, 1], speed, p[CL_V_LOW], p[CL_V_HIGH]), 0.0
     if kind == NORMAL:
         kin = clearance_kinematics(system, k, y[:n], y[n:2 * n])
         shift = hysteresis(system, k) if mode != FREE else 0.0
@@ -159,8 +146,6 @@ def interpolate(y, stages, h, theta, out):
 
 @njit(cache=True, inline="always")
 def _crossed(mode, kind, before, after):
-    if kind == BAND_END:
-        return (before < 0.0) != (after < 0.0)
     if kind == NORMAL and mode == FREE:
         return before < 0.0 and after >= 0.0
     return before >= 0.0 and after < 0.0
@@ -578,31 +563,6 @@ def refine_event(system, dynamics, projection, implicit_step, k, kind, t, y, f, 
     return h_event
 
 
-@njit(cache=True, inline="always")
-def band_end_step(system, dynamics, t, y, y_new, stages, h, points, modes, speeds, scratch, ints, suggested):
-    """The next try after a rejected one of length h: `suggested`, the controller's, or shorter, up to the first end of
-    a sliding joint's friction band (a kink of μ(v_t)) where the try crossed one between its ends, located on the
-    try's continuous extension. (Up to the band end however long: 6 554 steps and 1 807 rejected on the bundled
-    breaker, against 6 442 and 1 653 without; so never longer than the controller's.)"""
-    kind = np.int64(BAND_END)  # int64, as the other kinds: a literal would compile each callee once more for it
-    crossed = False
-    for k in range(modes.shape[0]):
-        start = event_value(system, dynamics, k, kind, t, y, modes, speeds)[0]
-        end = event_value(system, dynamics, k, kind, t + h, y_new, modes, speeds)[0]
-        crossed = crossed or _crossed(modes[k], kind, start, end)
-    if not crossed:
-        return suggested
-    ints[I_RHS] += extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints)
-    fill_subdivisions(y, stages, h, points)
-    theta = 2.0
-    for k in range(modes.shape[0]):
-        theta = min(theta, first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, modes, speeds, scratch))
-    if not BAND_END_MARGIN < theta < 1.0 or theta * h >= suggested:
-        return suggested
-    ints[I_BAND_END_TRIES] += 1
-    return theta * h
-
-
 @njit(cache=True)
 def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, f, real, ints, modes, speeds, episode_of, log_joint,
             log_onset, log_loss, log_speed, log_mass, peak_force, jacobian, jacobian_modes, out_t, out_y, out_modes,
@@ -670,11 +630,7 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
             if h <= real[R_MIN_STEP] * (1.0 + 1e-12):
                 ints[I_STATUS] = MIN_STEP
                 return
-            suggested = h * max(0.2, SAFETY * norm ** exponent)
-            if ints[I_BAND_END_STEPS]:
-                suggested = band_end_step(system, dynamics, t, y, y_new, stages, h, points, modes, speeds, scratch, ints,
-                                          suggested)
-            real[R_STEP] = max(suggested, real[R_MIN_STEP])
+            real[R_STEP] = max(h * max(0.2, SAFETY * norm ** exponent), real[R_MIN_STEP])
             if ints[I_JACOBIAN_AGE] > 0:  # a Jacobian that has served accepted steps may be what failed: take it anew
                 ints[I_JACOBIAN_AGE] = -1
             continue

@@ -229,7 +229,6 @@ class Run:
         self.ints = np.zeros(ig.INT_SLOTS, np.int64)
         self.ints[ig.I_METHOD] = ig.METHODS[settings.method]
         self.ints[ig.I_JACOBIAN_AGE] = -1
-        self.ints[ig.I_BAND_END_STEPS] = settings.band_ends == "located"
         # rosenbrock: ∂f/∂y and ∂f/∂t (last column), and the contact modes it was taken in
         size = self.y.size if settings.method == "rosenbrock" else 0
         self.jacobian = np.zeros((size, size + 1))

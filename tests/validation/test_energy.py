@@ -55,7 +55,7 @@ def test_elastic_impacts_conserve_energy_including_contact_potential(simulate, m
     assert np.max(np.abs(result["energy/contact_dissipated"])) <= 1e-9 * scale  # c_e = 1: nothing to dissipate
 
 
-@pytest.mark.parametrize("settings", [(), ("solver.method=dop853",), ("solver.band_ends=located",)])
+@pytest.mark.parametrize("settings", [(), ("solver.method=dop853",)])
 @pytest.mark.parametrize("friction", ["{law: none}", "{law: stiction_step, mu_s: 0.2, mu_d: 0.15, v_s: 1e-4 m/s, v_d: 1e-2 m/s}"])
 def test_written_dissipation_closes_the_energy_balance(simulate, friction, settings):
     text = CLEARANCE_PENDULUM.replace("law: hertz, restitution: 1.0", "law: lankarani_nikravesh, restitution: 0.7")

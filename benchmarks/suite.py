@@ -71,6 +71,11 @@ CASES = [
     Case("crank-frictionless", CRANK, (), ("solver.t_end=6ms",)),
     Case("crank-friction", CRANK_FRICTION, (), ("solver.t_end=6ms",)),
 ]
+# the dry cases again with the 8th-order explicit method (the reference at rtol/100 with the same settings)
+VARIANTS = (("-dop853", ("solver.method=dop853",)),)
+CASES += [Case(f"{case.name}{suffix}", case.config, case.overrides + settings, case.quick_overrides)
+          for suffix, settings in VARIANTS for case in CASES
+          if case.name in ("uhv-c0.01", "uhv-c0.1", "crank-frictionless", "crank-friction")]
 
 
 @dataclass

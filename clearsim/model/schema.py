@@ -873,7 +873,7 @@ class SolverSettings(Strict):
     max_step: Time = Field(1e-3, gt=0.0, description="largest step")
     min_step: Time = Field(1e-12, gt=0.0, description="smallest step (a rejected step at min_step stops the run)")
     initial_step: Time | None = Field(None, gt=0.0, description="first step size; default chosen by the solver")
-    method: Literal["dopri5", "rosenbrock"] = Field("dopri5", description="integration method: dopri5, the explicit Dormand–Prince 5(4); rosenbrock, the linearly implicit ROS34PW2 (order 3) for models whose steps a stiff force holds short while the motion is slow, such as a squeeze film (docs/model.md §4)")
+    method: Literal["dopri5", "rosenbrock", "dop853"] = Field("dopri5", description="integration method: dopri5, the explicit Dormand–Prince 5(4); dop853, the explicit Dormand–Prince 8(5,3) with its 7th-order continuous extension, for smooth models at tight tolerances; rosenbrock, the linearly implicit ROS34PW2 (order 3) for models whose steps a stiff force holds short while the motion is slow, such as a squeeze film (docs/model.md §4)")
 
     @model_validator(mode="after")
     def _steps_ordered(self):

@@ -36,7 +36,7 @@ DENSE = np.array([
 
 
 @njit(cache=True)
-def _accumulate(out, base, coefficients, h, stages, count):
+def accumulate(out, base, coefficients, h, stages, count):
     """out = base + Σ_{j<count} (h a_j) K_j, skipping zero coefficients (no temporaries)."""
     copy_into(out, base)
     for j in range(count):
@@ -47,20 +47,26 @@ def _accumulate(out, base, coefficients, h, stages, count):
 
 
 @njit(cache=True, inline="always")
-def step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new):
-    """One DOPRI5 step from (t, y) with ẏ(t) = f; fills stages (7, ny) and y_new; returns the error vector."""
-    copy_into(stages[0], f)
+def evaluate_stages(system, dynamics, t, y, h, modes, speeds, stages, matrix, nodes, first, last):
+    """stages[s] = f(t + c_s h, y + h Σ_{j<s} a_sj K_j) for s = first … last − 1 (an explicit tableau's rows)."""
     work = np.empty_like(y)
     # nodes at the step's end are evaluated just left of it: a prescribed motion may jump in acceleration
     # exactly there (the end of a stroke), and the step must see the piece it integrates over
     end = np.nextafter(t + h, t)
-    for s in range(1, 6):
-        _accumulate(work, y, MATRIX[s], h, stages, s)
-        rhs(system, dynamics, min(t + NODES[s] * h, end), work, modes, speeds, stages[s])
-    _accumulate(y_new, y, WEIGHTS, h, stages, WEIGHTS.shape[0])
-    rhs(system, dynamics, end, y_new, modes, speeds, stages[6])
+    for s in range(first, last):
+        accumulate(work, y, matrix[s], h, stages, s)
+        rhs(system, dynamics, min(t + nodes[s] * h, end), work, modes, speeds, stages[s])
+
+
+@njit(cache=True, inline="always")
+def step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new):
+    """One DOPRI5 step from (t, y) with ẏ(t) = f; fills stages (7, ny) and y_new; returns the error vector."""
+    copy_into(stages[0], f)
+    evaluate_stages(system, dynamics, t, y, h, modes, speeds, stages, MATRIX, NODES, np.int64(1), MATRIX.shape[0])
+    accumulate(y_new, y, WEIGHTS, h, stages, WEIGHTS.shape[0])
+    rhs(system, dynamics, np.nextafter(t + h, t), y_new, modes, speeds, stages[6])
     error = np.zeros_like(y)
-    _accumulate(error, error, ERROR_WEIGHTS, h, stages, ERROR_WEIGHTS.shape[0])
+    accumulate(error, error, ERROR_WEIGHTS, h, stages, ERROR_WEIGHTS.shape[0])
     return error
 
 
@@ -84,20 +90,28 @@ def error_norm(error, y, y_new, count, skipped, tail, rtol, atol):
     return np.sqrt(total / (y.shape[0] - skipped - tail))
 
 
-@njit(cache=True)
-def interpolate(y, stages, h, theta, out):
-    """Continuous extension y(t + θh) into out (one pass, no temporaries; each element sums its stages in order)."""
-    weights = np.empty(STAGES)
-    for j in range(STAGES):
+@njit(cache=True, inline="always")
+def dense_output(y, stages, dense, h, theta, out):
+    """y(t + θh) = y + h Σ_j K_j Σ_p dense_jp θ^(p+1) into out (one pass, no temporaries; each element sums its stages
+    in order): the continuous extension of a method whose stage weights are the polynomials of `dense`. Inlined, so
+    that a method's own table is a constant there, its loops of known length (as fast as a loop written for it)."""
+    weights = np.empty(dense.shape[0])
+    for j in range(dense.shape[0]):
         weight = 0.0
         power = theta
-        for p in range(4):
-            weight += DENSE[j, p] * power
+        for p in range(dense.shape[1]):
+            weight += dense[j, p] * power
             power *= theta
         weights[j] = h * weight if weight != 0.0 else 0.0
     for i in range(out.shape[0]):
         value = y[i]
-        for j in range(STAGES):
+        for j in range(dense.shape[0]):
             if weights[j] != 0.0:
                 value += weights[j] * stages[j, i]
         out[i] = value
+
+
+@njit(cache=True)
+def interpolate(y, stages, h, theta, out):
+    """DOPRI5's continuous extension y(t + θh) into out (dense_output with DENSE)."""
+    dense_output(y, stages, DENSE, h, theta, out)

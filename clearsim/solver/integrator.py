@@ -1,4 +1,5 @@
-"""The compiled integration loop: adaptive DOPRI5 steps, contact events, fixed-rate samples.
+"""The compiled integration loop: adaptive steps of the run's method (DOPRI5, DOP853 or Rosenbrock), contact events,
+fixed-rate samples.
 
 Each clearance joint has a mode (free / contact) that is constant within a step, so every
 step integrates a smooth right-hand side. Contact onset (δ rising through 0) and loss (δ
@@ -51,8 +52,8 @@ from clearsim.assembly.forces import (
 from clearsim.physics.contact import HERTZ_CONTACT_TIME_FACTOR
 from clearsim.physics.cylindrical import is_power_law, law_max_penetration
 from clearsim.physics.friction import static_coefficient
-from clearsim.solver import rosenbrock
-from clearsim.solver.dopri import STAGES, error_norm, interpolate, step
+from clearsim.solver import dop853, rosenbrock
+from clearsim.solver.dopri import DENSE, STAGES, dense_output, error_norm, step
 from clearsim.solver.samples import derive_sample
 
 # real_state slots
@@ -69,8 +70,8 @@ REAL_SLOTS = 17
 # one to take anew: rosenbrock.jacobian_is_stale)
 I_METHOD, I_JACOBIAN_AGE = 14, 15
 INT_SLOTS = 16
-DOPRI5, ROSENBROCK = range(2)
-METHODS = {"dopri5": DOPRI5, "rosenbrock": ROSENBROCK}
+DOPRI5, ROSENBROCK, DOP853 = range(3)
+METHODS = {"dopri5": DOPRI5, "rosenbrock": ROSENBROCK, "dop853": DOP853}
 
 RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END, CHATTER, FIRST_STEP, PAUSED = range(11)
 # PAUSED: STEPS_PER_CALL steps tried since the call began; call again (Ctrl-C and the progress bar are handled in
@@ -131,6 +132,16 @@ def event_value(system, dynamics, k, kind, t, y, modes, speeds):
         return friction_reserve(system, dynamics, t, y, modes, speeds, k)[0], 0.0
     direction = -1.0 if mode == SLIDE_BACK else 1.0
     return direction * clearance_kinematics(system, k, y[:n], y[n:2 * n])[8] + SLIDE_HYSTERESIS, 0.0
+
+
+@njit(cache=True)
+def interpolate(y, stages, h, theta, out):
+    """The step's continuous extension y(t + θh) into out; the rows of `stages` name the method's: DOP853's 16, else
+    DOPRI5's 7 (in whose form the Rosenbrock steps write theirs)."""
+    if stages.shape[0] == dop853.STAGES:
+        dense_output(y, stages, dop853.DENSE, h, theta, out)
+    else:
+        dense_output(y, stages, DENSE, h, theta, out)
 
 
 @njit(cache=True, inline="always")
@@ -494,13 +505,34 @@ def update_output_peak(n, y, f, real):
 def method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stages, y_new, real, ints, jacobian,
                 jacobian_modes, take_jacobian):
     """One step of the run's method (ints[I_METHOD]); ROSENBROCK: by address (rosenbrock.attempt), J taken anew first
-    when take_jacobian. Returns (the error vector, the rhs evaluations made)."""
+    when take_jacobian. Returns (the error norm, the rhs evaluations made)."""
     if ints[I_METHOD] == ROSENBROCK:
         error = implicit_step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian, jacobian_modes,
                               take_jacobian, real[R_ATOL] / real[R_RTOL])
         taken = rosenbrock.jacobian_evaluations(jacobian_modes) if take_jacobian else 0
-        return error, rosenbrock.STAGES + taken
-    return step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new), 6
+        return steering_norm(system, error, y, y_new, real), rosenbrock.STAGES + taken
+    if ints[I_METHOD] == DOP853:
+        high, low = dop853.step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new)
+        return (dop853.combined_norm(steering_norm(system, high, y, y_new, real),
+                                     steering_norm(system, low, y, y_new, real)), dop853.TRIAL_EVALUATIONS)
+    return steering_norm(system, step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new), y, y_new, real), 6
+
+
+@njit(cache=True, inline="always")
+def steering_norm(system, error, y, y_new, real):
+    """The error norm over the components that steer the steps (dopri.error_norm)."""
+    return error_norm(error, y, y_new, 2 * coordinate_count(system), WORK_COUNT, wear_state_count(system), real[R_RTOL],
+                      real[R_ATOL])
+
+
+@njit(cache=True, inline="always")
+def extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints):
+    """The continuous extension's own stages of a step taken, where the method has them (DOP853); returns the rhs
+    evaluations made."""
+    if ints[I_METHOD] != DOP853:
+        return 0
+    dop853.extend(system, dynamics, t, y, h, modes, speeds, stages)
+    return dop853.EXTENSION_EVALUATIONS
 
 
 @njit(cache=True, inline="always")
@@ -538,8 +570,7 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
     """Integrate until t_stop, the end, a full buffer, STEPS_PER_CALL tried steps or a failure; the status is
     ints[I_STATUS]."""
     n = coordinate_count(system)
-    unsteering_tail = wear_state_count(system)  # the wear states end y and steer no step: fixed at assembly
-    stages = np.empty((STAGES, y.shape[0]))
+    stages = np.empty((dop853.STAGES if ints[I_METHOD] == DOP853 else STAGES, y.shape[0]))
     y_new = np.empty_like(y)
     scratch = np.empty_like(y)
     points = np.empty((SUBDIVISIONS + 1, y.shape[0]))
@@ -548,6 +579,8 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
     attempts = 0
     # the step-size controller's exponent: −1/(q + 1) for the embedded order q
     exponent = -1.0 / (rosenbrock.EMBEDDED_ORDER + 1) if ints[I_METHOD] == ROSENBROCK else -0.2
+    if ints[I_METHOD] == DOP853:
+        exponent = -1.0 / (dop853.ERROR_ORDER + 1)
     if real[R_STEP] <= 0.0:
         rhs(system, dynamics, real[R_TIME], y, modes, speeds, f)
         ints[I_STATUS] = FIRST_STEP
@@ -585,12 +618,11 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
                 return
             h = (capacity - 2) * real[R_SAMPLE_DT]
         take_jacobian = jacobian_due(ints, modes, jacobian_modes)
-        error, evaluations = method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stages, y_new, real,
-                                         ints, jacobian, jacobian_modes, take_jacobian)
+        norm, evaluations = method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stages, y_new, real,
+                                        ints, jacobian, jacobian_modes, take_jacobian)
         ints[I_RHS] += evaluations
         if take_jacobian:
             ints[I_JACOBIAN_AGE] = 0
-        norm = error_norm(error, y, y_new, 2 * n, WORK_COUNT, unsteering_tail, real[R_RTOL], real[R_ATOL])
         if not np.isfinite(norm):
             norm = 1e10
         if norm > 1.0:
@@ -604,12 +636,14 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
             continue
         real[R_STEP] = h * min(10.0, max(0.2, SAFETY * norm ** exponent)) if norm > 0.0 else 10.0 * h
         ints[I_JACOBIAN_AGE] += 1
+        ints[I_RHS] += extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints)
         fill_subdivisions(y, stages, h, points)
         event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, points, modes,
                                                               speeds, scratch)
         if event_joint >= 0:
             h = refine_event(system, dynamics, projection, implicit_step, event_joint, event_kind, t, y, f,
                              event_theta * h, modes, speeds, stages, y_new, real, ints, jacobian, jacobian_modes)
+            ints[I_RHS] += extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints)
             fill_subdivisions(y, stages, h, points)  # the step integrated again, to the event
         emit_samples(system, dynamics, films, projection, implicit_step, t, y, f, stages, h, t + h, modes, speeds,
                      episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,

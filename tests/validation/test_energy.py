@@ -44,8 +44,9 @@ def test_double_pendulum_conserves_energy_over_many_swings(simulate):
     assert np.max(result["constraints/violation"]) <= 1e-9
 
 
-def test_elastic_impacts_conserve_energy_including_contact_potential(simulate):
-    result = simulate(CLEARANCE_PENDULUM)
+@pytest.mark.parametrize("method", ["dopri5", "dop853"])
+def test_elastic_impacts_conserve_energy_including_contact_potential(simulate, method):
+    result = simulate(CLEARANCE_PENDULUM, f"solver.method={method}")
     events = result["joints/O/episodes/onset"]
     assert len(events) >= 100  # hundreds of impacts make the test meaningful
     energy = total_energy(result)
@@ -54,11 +55,12 @@ def test_elastic_impacts_conserve_energy_including_contact_potential(simulate):
     assert np.max(np.abs(result["energy/contact_dissipated"])) <= 1e-9 * scale  # c_e = 1: nothing to dissipate
 
 
+@pytest.mark.parametrize("settings", [(), ("solver.method=dop853",)])
 @pytest.mark.parametrize("friction", ["{law: none}", "{law: stiction_step, mu_s: 0.2, mu_d: 0.15, v_s: 1e-4 m/s, v_d: 1e-2 m/s}"])
-def test_written_dissipation_closes_the_energy_balance(simulate, friction):
+def test_written_dissipation_closes_the_energy_balance(simulate, friction, settings):
     text = CLEARANCE_PENDULUM.replace("law: hertz, restitution: 1.0", "law: lankarani_nikravesh, restitution: 0.7")
     text = text.replace("  contact:", f"  friction: {friction}\n  contact:")
-    result = simulate(text)
+    result = simulate(text, *settings)
     lost = result["energy/contact_dissipated"][-1] + result["energy/friction_dissipated"][-1]
     assert lost > 1e-4 * np.max(result["energy/kinetic"])  # precondition: there is dissipation to account for
     assert np.max(np.abs(result["energy/balance_error"])) <= 1e-3 * lost

@@ -146,9 +146,10 @@ def test_diagnose_takes_the_noise_from_repeated_records(tmp_path):
 def test_diagnose_does_not_count_a_rattle_it_does_not_replay_as_noise(tmp_path):
     """The slider-crank's 0.5 mm slider pin rattling, the record's journal started 1 µm off (a realisation of the chaotic
     impacts that no model run repeats, as on a bench), slider displacement and velocity, 0.5 % noise through a 10 kHz
-    filter: σ̂ of the velocity in diagnosis.json is within 1.5× the true noise's in the comparison band (measured 1.19;
-    6.2 with the flat part's mean as the floor: the residual against the model holds both rattles, the record minus
-    its trend the record's). The true noise is the noisy record minus the noiseless one of the same seed."""
+    filter: σ̂ of each sensor in diagnosis.json is within 1.5× the true noise's in the comparison band (measured: the
+    velocity 1.18, 8.8 with the flat part's mean as the floor: the residual against the model holds both rattles, the
+    record minus its trend the record's; the displacement 1.06). The true noise is the noisy record minus the
+    noiseless one of the same seed."""
     runner = CliRunner()
     bench = ["--sensors", "slider_displacement,slider_velocity", "--rate", "50kHz", "--lowpass", "10kHz", "--seed", "3",
              "--set", "joints.slider_pin.initial_eccentricity=[1e-6 m, 0 m]"]

@@ -40,6 +40,9 @@ HANN_BINS = 1.5  # equivalent noise bandwidth of the Hann window, in bins: neigh
 OVERLAP_VARIANCE = 1.056  # Welch (1967): variance of a 50 %-overlap Hann average over that of independent segments
 MEDIAN_EFFICIENCY = 1.0 / (4.0 * np.log(2.0) ** 2)  # of a median of exponential (χ²₂) bins against their mean: 0.52
 INTERVAL_LEVEL = 0.95  # the χ² interval reported on σ̂
+PLATEAU_BINS = 9  # the running median of the noise spectrum whose lowest value is the rattle-free floor
+PLATEAU_SEGMENTS = 6  # fewer Welch segments: white noise alone would pass RATTLE_EXCESS in a few % of records
+RATTLE_EXCESS = 9.0  # the flat part's mean above this × the rattle-free floor: the flat part holds a rattle (σ̂ 3×)
 
 TREND, QUIET, REPEATS = "trend", "quiet", "repeats"  # the noise estimators (docs/diagnose.md §1)
 
@@ -116,7 +119,7 @@ def estimate_noise(values: np.ndarray | list[np.ndarray], rate: float, quiet: np
     if not np.any(valid):
         return NoiseEstimate(float(np.std(scatters[0])), float(count), count, None, estimator=estimator)
     noise = np.where(valid, density / np.where(valid, passed, 1.0), 0.0)
-    level, bins = _floor_level(frequencies, noise, valid)
+    level, bins = _floor_level(frequencies, noise, valid, len(segments))
     bandwidth = _bandwidth(frequencies, noise, level)
     noise = np.where(valid, np.minimum(noise, LINE_FACTOR * level), level)  # lines far above the floor are signal
     variance = float(np.trapezoid(noise, frequencies))
@@ -199,10 +202,13 @@ def equivalent_bandwidth(cutoff: float) -> float:
     return cutoff * quad(lambda x: 1.0 / (1.0 + x ** (2 * COMPARISON_FILTER_ORDER)) ** 2, 0.0, np.inf)[0]
 
 
-def _floor_level(frequencies: np.ndarray, noise: np.ndarray, valid: np.ndarray) -> tuple[float, int]:
+def _floor_level(frequencies: np.ndarray, noise: np.ndarray, valid: np.ndarray, segments: int) -> tuple[float, int]:
     """The flat noise floor and the number of bins it is the mean of: the mean density over the flat part of the
     passband (up to FLAT_PART of the bandwidth), spectral lines above LINE_FACTOR × the median left out. Two rounds:
-    the lowest valid bins give the bandwidth, the bandwidth gives the flat part."""
+    the lowest valid bins give the bandwidth, the bandwidth gives the flat part. Where that mean exceeds the
+    rattle-free floor (`rattle_free_floor`) by more than RATTLE_EXCESS, the flat part holds a rattle (its spectrum
+    falls with frequency, the noise's does not) and the rattle-free floor is the level; not from fewer than
+    PLATEAU_SEGMENTS Welch segments, whose bins scatter too much for their lowest median to mean anything."""
     first = np.nonzero(valid)[0][:FLOOR_BINS]
     bandwidth = _bandwidth(frequencies, noise, float(np.median(noise[first])))
     flat = valid & (frequencies <= FLAT_PART * (bandwidth or frequencies[-1] / FLAT_PART))
@@ -210,7 +216,29 @@ def _floor_level(frequencies: np.ndarray, noise: np.ndarray, valid: np.ndarray) 
         flat = valid
     typical = float(np.median(noise[flat]))
     kept = noise[flat][noise[flat] <= LINE_FACTOR * typical]
-    return (float(np.mean(kept)), len(kept)) if len(kept) else (typical, 1)
+    level, bins = (float(np.mean(kept)), len(kept)) if len(kept) else (typical, 1)
+    plateau = rattle_free_floor(frequencies, noise, valid) if segments >= PLATEAU_SEGMENTS else None
+    return (plateau, PLATEAU_BINS) if plateau is not None and level > RATTLE_EXCESS * plateau else (level, bins)
+
+
+def rattle_free_floor(frequencies: np.ndarray, noise: np.ndarray, valid: np.ndarray) -> float | None:
+    """The lowest running median (PLATEAU_BINS valid bins) of the noise spectrum that is the lowest one of its own flat
+    part (up to FLAT_PART of the bandwidth it gives as a floor, as in `_floor_level`): an upper bound of a white noise's
+    density that a rattle's spectrum, falling with frequency, reaches only where it has fallen below the noise. A
+    level in the bench filter's roll-off lies beyond its own flat part, so it is not one; nor is a level the spectrum
+    stays above to the Nyquist frequency (no bench filter: no roll-off tells the passband's end). None: too few valid
+    bins, or no such level."""
+    where = np.nonzero(valid)[0]
+    if len(where) < 2 * PLATEAU_BINS:
+        return None
+    medians = np.median(np.lib.stride_tricks.sliding_window_view(noise[where], PLATEAU_BINS), axis=1)
+    centres = frequencies[where][PLATEAU_BINS // 2: PLATEAU_BINS // 2 + len(medians)]
+    for level in np.sort(medians[medians > 0.0]):
+        bandwidth = _bandwidth(frequencies, noise, float(level))
+        flat = medians[centres <= FLAT_PART * bandwidth] if bandwidth is not None else []
+        if len(flat) and np.min(flat) == level:
+            return float(level)
+    return None
 
 
 def _bandwidth(frequencies: np.ndarray, noise: np.ndarray, level: float) -> float | None:

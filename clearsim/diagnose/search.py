@@ -71,6 +71,7 @@ REFIT_ROUNDS = 3
 REFIT_STEP = 0.04  # first stencil step of the joint refit, in unit coordinates (4 % of each range)
 REFIT_REACH = 2.0  # the quadratic's minimum is looked for within 2 steps of the best point
 PERTURBATIONS = 3  # re-rolled impact sequences (candidates.perturbed) in which a found effect must still beat the model
+RETAINED = 0.5  # of its improvement over the model, the share a found effect must keep in its median re-rolled run
 
 
 @dataclass
@@ -626,6 +627,15 @@ def robust_to_perturbations(scored: Scored, record: Record) -> bool:
     """In each of PERTURBATIONS re-rolled impact sequences the effect still beats the model by the BIC margin: its
     evidence is not one lucky realisation of a chaotic sequence."""
     return len(scored.perturbed) >= PERTURBATIONS and max(scored.perturbed) < -bic_margin(record.effective_samples)
+
+
+def keeps_its_gain(scored: Scored, baseline_chi_square: float) -> bool:
+    """The median of the effect's re-rolled runs (scored.perturbed: Δχ² over the model) keeps at least RETAINED of the
+    improvement of its estimate: when it does not, the estimate's improvement is one lucky realisation of a chaotic
+    impact sequence (the ensemble's 1 nm twins, started alike, often replay the same one). No re-rolled runs: kept."""
+    if not scored.perturbed:
+        return True
+    return float(np.median(scored.perturbed)) <= RETAINED * (scored.estimate.chi_square - baseline_chi_square)
 
 
 def no_change(candidate: Candidate) -> float:

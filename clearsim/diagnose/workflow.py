@@ -30,8 +30,9 @@ from clearsim.diagnose.features import Feature, Window, disagreement_windows, fe
 from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_mapping, read_measured
 from clearsim.diagnose.search import (AS_GIVEN, PERTURBATIONS, SIGNIFICANCE, Ensembled, JointFit, PairFit, Point, Scored,
                                      SearchProgress, candidate_pairs, fit_pair, no_change, reaches_no_change, unbounded,
-                                     Tracked, aligned_residuals, halves_improved, judge, low_band_best, mark_ties,
-                                     profile_threshold, refine, refit_jointly, robust_to_perturbations, score_point, screen,
+                                     Tracked, aligned_residuals, halves_improved, judge, keeps_its_gain, low_band_best,
+                                     mark_ties, profile_threshold, refine, refit_jointly, robust_to_perturbations,
+                                     score_point, screen,
                                      seen_by_sensors, setting, significant_on_both_halves, to_fit, twin_gaps)
 from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.model.loader import load_mechanism, load_mechanism_text
@@ -517,14 +518,25 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
             "runs scatter as much as it improves, one lucky run, not a missing effect")
         winner = None
     if winner is not None:
-        mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
-        winner.halves = halves_improved(record, base_point, winner.estimate)
         evaluator.stage(f"iteration {number}: re-rolling the impacts {PERTURBATIONS} times")
         winner.perturbed = perturbed_changes(evaluator, record, sensors, document, winner, base_point, request)
+        if not keeps_its_gain(winner, baseline.chi_square):
+            say(f"  {winner.candidate.label} fits better (Δχ² {winner.estimate.chi_square - baseline.chi_square:.0f}) "
+                f"but only by {median_change(winner):.0f} with the impacts re-rolled (median of {PERTURBATIONS} runs): "
+                "one lucky realisation, not a missing effect")
+            winner = None
+    if winner is not None:
+        mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
+        winner.halves = halves_improved(record, base_point, winner.estimate)
         say(f"  found: {effect_line(found_effect(winner, baseline))}")
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
+
+
+def median_change(scored: Scored) -> float:
+    """The median Δχ² over the model of the effect's re-rolled runs."""
+    return float(np.median(scored.perturbed))
 
 
 def needle(scored: Scored) -> str | None:

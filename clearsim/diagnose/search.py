@@ -635,7 +635,12 @@ def keeps_its_gain(scored: Scored, baseline_chi_square: float) -> bool:
     impact sequence (the ensemble's 1 nm twins, started alike, often replay the same one). No re-rolled runs: kept."""
     if not scored.perturbed:
         return True
-    return float(np.median(scored.perturbed)) <= RETAINED * (scored.estimate.chi_square - baseline_chi_square)
+    return median_change(scored) <= RETAINED * (scored.estimate.chi_square - baseline_chi_square)
+
+
+def median_change(scored: Scored) -> float:
+    """The median Δχ² over the model of the effect's re-rolled runs (scored.perturbed)."""
+    return float(np.median(scored.perturbed))
 
 
 def no_change(candidate: Candidate) -> float:

@@ -31,9 +31,9 @@ from clearsim.diagnose.measured import MeasuredData, model_sensor_units, parse_m
 from clearsim.diagnose.search import (AS_GIVEN, PERTURBATIONS, SIGNIFICANCE, Ensembled, JointFit, PairFit, Point, Scored,
                                      SearchProgress, candidate_pairs, fit_pair, no_change, reaches_no_change, unbounded,
                                      Tracked, aligned_residuals, halves_improved, judge, keeps_its_gain, low_band_best,
-                                     mark_ties, profile_threshold, refine, refit_jointly, robust_to_perturbations,
-                                     score_point, screen,
-                                     seen_by_sensors, setting, significant_on_both_halves, to_fit, twin_gaps)
+                                     mark_ties, median_change, profile_threshold, refine, refit_jointly,
+                                     robust_to_perturbations, score_point, screen, seen_by_sensors, setting,
+                                     significant_on_both_halves, to_fit, twin_gaps)
 from clearsim.errors import ClearsimError, did_you_mean
 from clearsim.model.loader import load_mechanism, load_mechanism_text
 from clearsim.model.resolve import is_clearance_joint
@@ -532,11 +532,6 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
-
-
-def median_change(scored: Scored) -> float:
-    """The median Δχ² over the model of the effect's re-rolled runs."""
-    return float(np.median(scored.perturbed))
 
 
 def needle(scored: Scored) -> str | None:

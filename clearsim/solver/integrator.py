@@ -69,8 +69,11 @@ REAL_SLOTS = 17
 # the integration method (METHODS) and, for ROSENBROCK, the accepted steps its Jacobian has served (−1: none yet, or
 # one to take anew: rosenbrock.jacobian_is_stale)
 I_METHOD, I_JACOBIAN_AGE = 14, 15
-INT_SLOTS = 16
+# the states at the end of y that steer no step (dynamics.wear_state_count: fixed at assembly, set once per call)
+I_UNSTEERING_TAIL = 16
+INT_SLOTS = 17
 DOPRI5, ROSENBROCK, DOP853 = range(3)
+DOPRI5_ERROR_ORDER = 4  # DOPRI5's embedded solution
 METHODS = {"dopri5": DOPRI5, "rosenbrock": ROSENBROCK, "dop853": DOP853}
 
 RUNNING, DONE, MIN_STEP, NOT_FINITE, DRIFT, TOO_DEEP, BUFFER_FULL, CHUNK_END, CHATTER, FIRST_STEP, PAUSED = range(11)
@@ -510,19 +513,30 @@ def method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stag
         error = implicit_step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian, jacobian_modes,
                               take_jacobian, real[R_ATOL] / real[R_RTOL])
         taken = rosenbrock.jacobian_evaluations(jacobian_modes) if take_jacobian else 0
-        return steering_norm(system, error, y, y_new, real), rosenbrock.STAGES + taken
+        return steering_norm(system, error, y, y_new, real, ints), rosenbrock.STAGES + taken
     if ints[I_METHOD] == DOP853:
         high, low = dop853.step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new)
-        return (dop853.combined_norm(steering_norm(system, high, y, y_new, real),
-                                     steering_norm(system, low, y, y_new, real)), dop853.TRIAL_EVALUATIONS)
-    return steering_norm(system, step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new), y, y_new, real), 6
+        return (dop853.combined_norm(steering_norm(system, high, y, y_new, real, ints),
+                                     steering_norm(system, low, y, y_new, real, ints)), dop853.TRIAL_EVALUATIONS)
+    return steering_norm(system, step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new), y, y_new, real,
+                         ints), 6
 
 
 @njit(cache=True, inline="always")
-def steering_norm(system, error, y, y_new, real):
+def steering_norm(system, error, y, y_new, real, ints):
     """The error norm over the components that steer the steps (dopri.error_norm)."""
-    return error_norm(error, y, y_new, 2 * coordinate_count(system), WORK_COUNT, wear_state_count(system), real[R_RTOL],
+    return error_norm(error, y, y_new, 2 * coordinate_count(system), WORK_COUNT, ints[I_UNSTEERING_TAIL], real[R_RTOL],
                       real[R_ATOL])
+
+
+@njit(cache=True, inline="always")
+def error_order(method):
+    """The order q of the error estimate that steers the steps of `method` (METHODS)."""
+    if method == ROSENBROCK:
+        return rosenbrock.EMBEDDED_ORDER
+    if method == DOP853:
+        return dop853.ERROR_ORDER
+    return DOPRI5_ERROR_ORDER
 
 
 @njit(cache=True, inline="always")
@@ -577,10 +591,9 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
     ints[I_STATUS] = RUNNING
     capacity = out_t.shape[0]
     attempts = 0
-    # the step-size controller's exponent: −1/(q + 1) for the embedded order q
-    exponent = -1.0 / (rosenbrock.EMBEDDED_ORDER + 1) if ints[I_METHOD] == ROSENBROCK else -0.2
-    if ints[I_METHOD] == DOP853:
-        exponent = -1.0 / (dop853.ERROR_ORDER + 1)
+    ints[I_UNSTEERING_TAIL] = wear_state_count(system)
+    # the step-size controller's exponent: −1/(q + 1) for the order q of the method's error estimate
+    exponent = -1.0 / (error_order(ints[I_METHOD]) + 1)
     if real[R_STEP] <= 0.0:
         rhs(system, dynamics, real[R_TIME], y, modes, speeds, f)
         ints[I_STATUS] = FIRST_STEP

@@ -28,7 +28,7 @@ from clearsim.assembly.forces import (
 from clearsim.assembly.drivelines import add_driveline_forces, driveline_powers
 from clearsim.assembly.hydraulics import add_hydraulic_forces, hydraulic_rates
 from clearsim.assembly.kinematics import point_position
-from clearsim.assembly.arrays import CL_BEARING_POINT, CL_VISCOSITY, copy_into
+from clearsim.assembly.arrays import CL_BEARING_POINT, CL_VISCOSITY, copy_into, row_place
 
 WORK_DRIVER = 0
 WORK_CONTACT = 1
@@ -87,7 +87,27 @@ def factorize(system, m):
 
 @njit(cache=True)
 def solve_factored(system, x):
-    """x ← S⁻¹ x in place with the factor of the last factored_jacobian (NaN if S was not positive definite).
+    """x ← S⁻¹ x in place with the factor of the last factored_jacobian (NaN if S was not positive definite); x in
+    the rows' order, the factor in their places (arrays.row_place)."""
+    m = x.shape[0]
+    if system.factor_key[0] != FACTOR_SPD:
+        for r in range(m):
+            x[r] = np.nan
+        return
+    if system.row_place.shape[0] == 0:
+        _substitute(system, x)
+        return
+    placed = system.solve_placed[:m]
+    for r in range(m):
+        placed[row_place(system, r)] = x[r]
+    _substitute(system, placed)
+    for r in range(m):
+        x[r] = placed[row_place(system, r)]
+
+
+@njit(cache=True)
+def _substitute(system, x):
+    """x ← S⁻¹ x in place, x and the factor in the same order.
 
     Both substitutions loop over the envelope only, O(envelope): the forward one along row i of L from first[i],
     the backward one down column i of L, over the rows k > i whose envelope reaches it (first[k] ≤ i) in ascending
@@ -95,10 +115,6 @@ def solve_factored(system, x):
     a row leaves when i passes its first column, and never comes back.
     """
     m = x.shape[0]
-    if system.factor_key[0] != FACTOR_SPD:
-        for r in range(m):
-            x[r] = np.nan
-        return
     first = system.solve_envelope
     lower = system.solve_lower
     for i in range(m):

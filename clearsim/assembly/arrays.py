@@ -135,7 +135,8 @@ WORKSPACE_FIELDS = [
     "solve_body_fill",  # (nb,)
     "solve_vector",  # (3 nb,) M⁻¹ f, then Φ_qᵀ λ
     "solve_residual",  # (rows,)
-    "solve_placed",  # (rows,) a right-hand side in the places of row_place, while it is solved
+    "solve_place",  # (rows,) each row's place in S and its factor: row_place, then the rows past it in their own
+    "solve_placed",  # (rows,) a right-hand side in those places, while it is solved
     "factor_key",  # (1 + nc,) what solve_lower holds: none / positive definite / not; which joints have stick rows
     "factor_q",  # (3 nb,) the q it was computed at
 ]
@@ -161,11 +162,13 @@ def _workspace(arrays: SystemArrays) -> tuple:
     rows += arrays.clearance_bodies.shape[0]
     with np.errstate(divide="ignore"):  # as the kernels divide: a zero mass or inertia gives inf, not a warning
         inverse_mass = 1.0 / mass_diagonal(arrays)
+    places = np.arange(rows, dtype=np.int64)
+    places[:arrays.row_place.shape[0]] = arrays.row_place
     return (inverse_mass, np.zeros((rows, 2, 3)), np.zeros((rows, 2), np.int64), np.zeros((rows, rows)),
             np.zeros((rows, rows)), np.zeros(rows, np.int64), np.arange(rows, dtype=np.int64), np.zeros(rows, np.int64),
             np.zeros(bodies + 1, np.int64),
             np.zeros((2 * rows, 2), np.int64), np.zeros(bodies, np.int64), np.zeros(3 * bodies), np.zeros(rows),
-            np.zeros(rows), np.zeros(1 + arrays.clearance_bodies.shape[0], np.int64), np.zeros(3 * bodies))
+            places, np.zeros(rows), np.zeros(1 + arrays.clearance_bodies.shape[0], np.int64), np.zeros(3 * bodies))
 
 
 def for_kernels(arrays: SystemArrays) -> KernelArrays:
@@ -208,11 +211,6 @@ def blas_hidden():
     finally:
         del sys.modules[name]
 
-
-@njit(cache=True, inline="always")
-def row_place(system, row):
-    """The place of constraint (or stick) row `row` in S and its factor (row_place; its own when not listed)."""
-    return system.row_place[row] if row < system.row_place.shape[0] else row
 
 
 @njit(cache=True, inline="always")

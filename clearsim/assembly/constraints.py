@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from clearsim.assembly.arrays import OFF_DIRECTION, OFF_POINT_I, OFF_POINT_J, OFF_VALUE, row_place
+from clearsim.assembly.arrays import OFF_DIRECTION, OFF_POINT_I, OFF_POINT_J, OFF_VALUE
 from clearsim.assembly.kinematics import body_frame, body_pose, body_rates, frame_point, frame_rotate, frame_velocity
 from clearsim.physics.motion import evaluate_piecewise
 
@@ -177,7 +177,7 @@ def schur_complement(system, blocks, bodies):
     Row i of S can be nonzero from column band[i] on (system.solve_band: the first row sharing a body with it;
     the rows past these blocks' have band[i] = i and an empty row). Only the band of the last call is cleared and
     only the band is written, so a call costs O(rows × bandwidth), not O(rows²), and S is zero outside the band.
-    S, its band and its factor are in the rows' places (arrays.row_place): entry (row_place(i), row_place(j)).
+    S, its band and its factor are in the rows' places (arrays.row_place): entry (place[i], place[j]) (solve_place).
     """
     m = blocks.shape[0]
     minv = system.inverse_mass
@@ -206,15 +206,16 @@ def schur_complement(system, blocks, bodies):
     clear_band(schur, band)
     for row in range(band.shape[0]):
         band[row] = row
+    places = system.solve_place
     for b in range(nb):  # filled[b] ← the first place of the body's rows
         filled[b] = m
         for e in range(count[b], count[b + 1]):
-            filled[b] = min(filled[b], row_place(system, entries[e, 0]))
+            filled[b] = min(filled[b], places[entries[e, 0]])
     for row in range(m):
         for slot in range(2):
             b = bodies[row, slot]
             if b >= 0:
-                place = row_place(system, row)
+                place = places[row]
                 band[place] = min(band[place], filled[b])
     for b in range(nb):
         for e in range(count[b], count[b + 1]):
@@ -224,9 +225,10 @@ def schur_complement(system, blocks, bodies):
                 total = 0.0
                 for c in range(3):
                     total += blocks[i, si, c] * minv[3 * b + c] * blocks[j, sj, c]
-                schur[row_place(system, i), row_place(system, j)] += total
+                pi, pj = places[i], places[j]
+                schur[pi, pj] += total
                 if i != j:
-                    schur[row_place(system, j), row_place(system, i)] += total
+                    schur[pj, pi] += total
 
 
 @njit(cache=True)

@@ -28,7 +28,7 @@ from clearsim.assembly.forces import (
 from clearsim.assembly.drivelines import add_driveline_forces, driveline_powers
 from clearsim.assembly.hydraulics import add_hydraulic_forces, hydraulic_rates
 from clearsim.assembly.kinematics import point_position
-from clearsim.assembly.arrays import CL_BEARING_POINT, CL_VISCOSITY, copy_into, row_place
+from clearsim.assembly.arrays import CL_BEARING_POINT, CL_VISCOSITY, copy_into
 
 WORK_DRIVER = 0
 WORK_CONTACT = 1
@@ -97,15 +97,16 @@ def solve_factored(system, x):
     if system.row_place.shape[0] == 0:
         _substitute(system, x)
         return
+    places = system.solve_place
     placed = system.solve_placed[:m]
     for r in range(m):
-        placed[row_place(system, r)] = x[r]
+        placed[places[r]] = x[r]
     _substitute(system, placed)
     for r in range(m):
-        x[r] = placed[row_place(system, r)]
+        x[r] = placed[places[r]]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _substitute(system, x):
     """x ← S⁻¹ x in place, x and the factor in the same order.
 

@@ -78,7 +78,7 @@ FIELD_LAYOUT = {
     "solve_lower": ("f8", 2), "solve_envelope": ("i8", 1), "solve_band": ("i8", 1),
     "solve_next_row": ("i8", 1), "solve_body_start": ("i8", 1),
     "solve_entries": ("i8", 2), "solve_body_fill": ("i8", 1), "solve_vector": ("f8", 1),
-    "solve_residual": ("f8", 1), "solve_placed": ("f8", 1), "factor_key": ("i8", 1), "factor_q": ("f8", 1),
+    "solve_residual": ("f8", 1), "solve_place": ("i8", 1), "solve_placed": ("f8", 1), "factor_key": ("i8", 1), "factor_q": ("f8", 1),
 }
 
 _helper: subprocess.Popen | None = None

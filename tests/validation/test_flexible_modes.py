@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+import yaml
 from typer.testing import CliRunner
 
 from clearsim.cli import app
@@ -18,6 +19,7 @@ from clearsim.model.modes import (MODES_REPORTED, JointFrequencies, axial_mode_f
                                   linearised_link_modes, mode_lines, mode_report, near, reported_modes)
 
 from tests.validation.test_flexible_axial import LINK, OMEGA, PERIOD, STIFFNESS, TIP, mass_on_link
+from tests.validation.test_flexible_beam import BENDING, LENGTH, MASS_PER_LENGTH, cantilever
 
 # two links in series along x, O–A and A–B, pinned to ground at O, a mass M pinned at B; no gravity. With the second
 # link held rigid the first one's slide carries its own far half, the whole second link and M: m_eff = m₁/2 + m₂ + M;
@@ -77,35 +79,27 @@ def test_the_report_names_the_joints_whose_contacts_or_whirl_lie_near_each_mode(
     assert lines[1].startswith("flexible link board: axial mode 1.6 kHz, near joint A's contacts and joint J's whirl")
 
 
-# a beam link pinned at x = 0 and carried at x = L by a roller (a slider on a horizontal guide): simply supported, its
-# bending modes ω_k = (kπ)² √(E I/(ρ A L⁴)); the roller's mass moves only along the axis, which the inextensible
-# chain holds still to first order
-SUPPORTED_LENGTH, SUPPORTED_MASS, SUPPORTED_BENDING = 1.0, 1.0, 100.0  # m, kg, N·m² (E = 100 GPa, I = 1e-9 m⁴)
-SIMPLY_SUPPORTED = """
-name: simply supported beam
-units: SI
-bodies:
-  - name: beam
-    mass: {mass}
-    inertia: {inertia}
-    position: [{middle}, 0]
-    flexible: {{model: beam, youngs_modulus: 100 GPa, second_moment_of_area: 1e-9 m^4, segments: SEGMENTS}}
-  - {{name: roller, mass: 0.01, inertia: 1e-6, position: [{length}, 0]}}
-joints:
-  - {{name: root, type: revolute, bodies: [ground, beam], at: [0, 0]}}
-  - {{name: end, type: revolute, bodies: [beam, roller], at: [{length}, 0]}}
-  - {{name: guide, type: prismatic, bodies: [ground, roller], at: [{length}, 0], axis: [1, 0]}}
-solver: {{t_end: 1 ms}}
-""".format(mass=SUPPORTED_MASS, inertia=SUPPORTED_MASS * SUPPORTED_LENGTH ** 2 / 12, middle=SUPPORTED_LENGTH / 2,
-           length=SUPPORTED_LENGTH)
+# the cantilever of test_flexible_beam.py unclamped and carried at x = L by a roller (a slider on a horizontal guide):
+# simply supported, its bending modes ω_k = (kπ)² √(E I/(ρ A L⁴)); the roller's mass moves only along the axis, which
+# the inextensible chain holds still to first order
 SUPPORTED_MODES = (np.array([1, 2, 3]) * math.pi) ** 2 * math.sqrt(
-    SUPPORTED_BENDING / (SUPPORTED_MASS / SUPPORTED_LENGTH * SUPPORTED_LENGTH ** 4)) / (2 * math.pi)  # Hz: 15.7, 62.8, 141
+    BENDING / (MASS_PER_LENGTH * LENGTH ** 4)) / (2 * math.pi)  # Hz: 15.7, 62.8, 141
+
+
+def simply_supported(segments: int) -> str:
+    document = yaml.safe_load(cantilever(f", segments: {segments}"))
+    del document["drivers"], document["sensors"]
+    document["bodies"].append({"name": "roller", "mass": 0.01, "inertia": 1e-6, "position": [LENGTH, 0]})
+    document["joints"] += [{"name": "end", "type": "revolute", "bodies": ["beam", "roller"], "at": [LENGTH, 0]},
+                           {"name": "guide", "type": "prismatic", "bodies": ["ground", "roller"], "at": [LENGTH, 0],
+                            "axis": [1, 0]}]
+    return yaml.safe_dump(document)
 
 
 def supported_beam_errors(segments: int) -> np.ndarray:
     """The relative errors of the simply supported beam link's three lowest modes as linearised_link_modes gives
     them, cut into `segments` elements."""
-    loaded = load_mechanism_text(SIMPLY_SUPPORTED.replace("SEGMENTS", str(segments)))
+    loaded = load_mechanism_text(simply_supported(segments))
     modes = linearised_link_modes(loaded.mechanism, ["beam"], loaded.base_dir)["beam"]
     assert len(modes) == segments  # n hinges between two supports: n transverse modes, every one the beam's
     return np.array(modes[:3]) / SUPPORTED_MODES - 1

@@ -87,7 +87,7 @@ SystemArrays = namedtuple(
               np.zeros(0, np.int64)),
 )
 # row_place[r]: the place of constraint row r in S and its factor (assembly/constraints.py schur_complement,
-# assembly/dynamics.py solve_factored); empty: every row in its own place, as are the stick rows past it. A flexible
+# assembly/dynamics.py solve_rows); empty: every row in its own place, as are the stick rows past it. A flexible
 # model's rows lie joint by joint along the chain (build.ConstraintRows.places), where pins, offsets, angles would put
 # the slides' rows after every pin and their envelope across the whole factor.
 # wear_harmonics[k]: M of joint k's worn profile (0: a circular bore), whose coefficients [a_0, a_1, b_1, ...] are the

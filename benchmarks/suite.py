@@ -452,7 +452,8 @@ def flexible_pairs(quick: bool, folder: Path, measurements, repeats: int = 1) ->
         rows.append({"flexible": flexible_name, "rigid": rigid_name, "pairs": len(walls),
                      "wall_ratio_median": statistics.median(walls), "wall_ratio_min": min(walls),
                      "wall_ratio_max": max(walls), "integration_ratio_median": statistics.median(integrations),
-                     "integration_ratio_min": min(integrations), "integration_ratio_max": max(integrations)})
+                     "integration_ratio_min": min(integrations), "integration_ratio_max": max(integrations),
+                     "steps": {name: run[1].statistics.steps for name, run in runs.items()}})
     return rows
 
 

@@ -5,7 +5,8 @@ Three constraint primitives cover every ideal joint and driver:
   offset  (1 row)   (A_i w̄)·(P_j − P_i) − c0 − s(t) = 0          prismatic joint (w̄ ⊥ axis), prismatic/x/y driver
   angle   (1 row)   θ_j − θ_i − c0 − s(t) = 0                     prismatic rotation lock, revolute/angle driver
 with s(t) a piecewise polynomial (law index ≥ 0) or 0 (law index −1). Rows are ordered
-pins, offsets, angles. A clearance joint is no constraint: it is a force pair.
+pins, offsets, angles (Φ, λ and every vector of rows); the factor of S = Φ_q M⁻¹ Φ_qᵀ may hold them in another
+order (row_place). A clearance joint is no constraint: it is a force pair.
 Whatever a sweep varies (clearance, friction, masses) lives in these arrays, so a new value
 needs no recompilation.
 """
@@ -78,11 +79,17 @@ SystemArrays = namedtuple(
         "torsion_bodies", "torsion_params",
         "hydraulic_bodies", "hydraulic_params", "hydraulic_laws",
         "wear_harmonics", "wear_profile", "wear_depth_range", "wear_slots", "wear_rates",  # worn bores, Archard wear (physics/wear.py)
+        "row_place",  # each constraint row's place in the factor of S (see below)
     ],
     # force elements with states (assembly/hydraulics.py) and wear: none unless given
     defaults=(np.zeros((0, 2), np.int64), np.zeros((0, HYDRAULIC_COLUMNS)), np.zeros((0, HYDRAULIC_LAW_COLUMNS), np.int64),
-              np.zeros(0, np.int64), np.zeros((0, 1)), np.zeros(0), np.zeros((0, 2), np.int64), np.zeros((0, 2))),
+              np.zeros(0, np.int64), np.zeros((0, 1)), np.zeros(0), np.zeros((0, 2), np.int64), np.zeros((0, 2)),
+              np.zeros(0, np.int64)),
 )
+# row_place[r]: the place of constraint row r in S and its factor (assembly/constraints.py schur_complement,
+# assembly/dynamics.py solve_rows); empty: every row in its own place, as are the stick rows past it. A flexible
+# model's rows lie joint by joint along the chain (build.ConstraintRows.places), where pins, offsets, angles would put
+# the slides' rows after every pin and their envelope across the whole factor.
 # wear_harmonics[k]: M of joint k's worn profile (0: a circular bore), whose coefficients [a_0, a_1, b_1, ...] are the
 # start of the row wear_profile[k]; wear_depth_range[k] bounds its max − min (m; the nearest-point search's window).
 # wear_slots[k]: (first slot in z of its accumulated Archard profile, −1: none;
@@ -128,6 +135,8 @@ WORKSPACE_FIELDS = [
     "solve_body_fill",  # (nb,)
     "solve_vector",  # (3 nb,) M⁻¹ f, then Φ_qᵀ λ
     "solve_residual",  # (rows,)
+    "solve_place",  # (rows,) each row's place in S and its factor: row_place, then the rows past it in their own
+    "solve_placed",  # (rows,) a right-hand side in those places, while it is solved
     "factor_key",  # (1 + nc,) what solve_lower holds: none / positive definite / not; which joints have stick rows
     "factor_q",  # (3 nb,) the q it was computed at
 ]
@@ -153,11 +162,13 @@ def _workspace(arrays: SystemArrays) -> tuple:
     rows += arrays.clearance_bodies.shape[0]
     with np.errstate(divide="ignore"):  # as the kernels divide: a zero mass or inertia gives inf, not a warning
         inverse_mass = 1.0 / mass_diagonal(arrays)
+    places = np.arange(rows, dtype=np.int64)
+    places[:arrays.row_place.shape[0]] = arrays.row_place
     return (inverse_mass, np.zeros((rows, 2, 3)), np.zeros((rows, 2), np.int64), np.zeros((rows, rows)),
             np.zeros((rows, rows)), np.zeros(rows, np.int64), np.arange(rows, dtype=np.int64), np.zeros(rows, np.int64),
             np.zeros(bodies + 1, np.int64),
             np.zeros((2 * rows, 2), np.int64), np.zeros(bodies, np.int64), np.zeros(3 * bodies), np.zeros(rows),
-            np.zeros(1 + arrays.clearance_bodies.shape[0], np.int64), np.zeros(3 * bodies))
+            places, np.zeros(rows), np.zeros(1 + arrays.clearance_bodies.shape[0], np.int64), np.zeros(3 * bodies))
 
 
 def for_kernels(arrays: SystemArrays) -> KernelArrays:
@@ -199,6 +210,7 @@ def blas_hidden():
         yield
     finally:
         del sys.modules[name]
+
 
 
 @njit(cache=True, inline="always")

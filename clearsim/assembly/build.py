@@ -139,6 +139,16 @@ class ConstraintRows:
         owners = [p[-1] for p in self.pins for _ in range(2)]
         return owners + [o[-1] for o in self.offsets] + [a[-1] for a in self.angles]
 
+    def places(self, names: list[str]) -> np.ndarray:
+        """arrays.row_place: each row's place when every owner's rows lie together, the owners in the order of
+        `names` (the joints', then the drivers'), a joint's pins before its offset before its angle."""
+        owners = self.row_owners()
+        rank = {name: k for k, name in reversed(list(enumerate(names)))}
+        order = sorted(range(len(owners)), key=lambda row: rank[owners[row]])
+        places = np.empty(len(owners), np.int64)
+        places[order] = np.arange(len(owners))
+        return places
+
 
 @dataclass
 class Laws:
@@ -289,6 +299,8 @@ def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: l
         torsion_bodies=_int_array([s[0] for s in torsions], 2),
         torsion_params=_float_array([s[1] for s in torsions], TORSION_COLUMNS),
         **wear_arrays([c[4] for c in clearances], first_slot=sum(len(c[4]) for c in cylinders)),
+        row_place=rows.places([joint.name for joint in mechanism.joints] + [driver.name for driver in mechanism.drivers])
+        if mechanism.rows_along_the_chain else np.zeros(0, np.int64),
     )
 
 

@@ -177,6 +177,7 @@ def schur_complement(system, blocks, bodies):
     Row i of S can be nonzero from column band[i] on (system.solve_band: the first row sharing a body with it;
     the rows past these blocks' have band[i] = i and an empty row). Only the band of the last call is cleared and
     only the band is written, so a call costs O(rows × bandwidth), not O(rows²), and S is zero outside the band.
+    S, its band and its factor are in the rows' places (arrays.row_place): entry (place[i], place[j]) (solve_place).
     """
     m = blocks.shape[0]
     minv = system.inverse_mass
@@ -205,11 +206,17 @@ def schur_complement(system, blocks, bodies):
     clear_band(schur, band)
     for row in range(band.shape[0]):
         band[row] = row
+    places = system.solve_place
+    for b in range(nb):  # filled[b] ← the first place of the body's rows
+        filled[b] = m
+        for e in range(count[b], count[b + 1]):
+            filled[b] = min(filled[b], places[entries[e, 0]])
     for row in range(m):
         for slot in range(2):
             b = bodies[row, slot]
             if b >= 0:
-                band[row] = min(band[row], entries[count[b], 0])  # the body's rows are grouped in ascending order
+                place = places[row]
+                band[place] = min(band[place], filled[b])
     for b in range(nb):
         for e in range(count[b], count[b + 1]):
             i, si = entries[e, 0], entries[e, 1]
@@ -218,9 +225,10 @@ def schur_complement(system, blocks, bodies):
                 total = 0.0
                 for c in range(3):
                     total += blocks[i, si, c] * minv[3 * b + c] * blocks[j, sj, c]
-                schur[i, j] += total
+                pi, pj = places[i], places[j]
+                schur[pi, pj] += total
                 if i != j:
-                    schur[j, i] += total
+                    schur[pj, pi] += total
 
 
 @njit(cache=True)

@@ -53,6 +53,22 @@ def coordinate_count(system):
 
 
 @njit(cache=True)
+def solve_rows(system, x):
+    """x ← S⁻¹ x in place, x in the rows' order (pins, offsets, angles, stick rows), with the factor of the last
+    factored_jacobian, which holds them in their places (arrays.row_place): moved there, solved, moved back."""
+    if system.row_place.shape[0] == 0:
+        solve_factored(system, x)
+        return
+    places = system.solve_place
+    placed = system.solve_placed[:x.shape[0]]
+    for r in range(x.shape[0]):
+        placed[places[r]] = x[r]
+    solve_factored(system, placed)
+    for r in range(x.shape[0]):
+        x[r] = placed[places[r]]
+
+
+@njit(cache=True)
 def factorize(system, m):
     """Envelope (skyline) Cholesky factor of the symmetric m × m matrix S in system.solve_schur (small, dense)
     into system.solve_lower; False if S is not positive definite.
@@ -87,7 +103,8 @@ def factorize(system, m):
 
 @njit(cache=True)
 def solve_factored(system, x):
-    """x ← S⁻¹ x in place with the factor of the last factored_jacobian (NaN if S was not positive definite).
+    """x ← S⁻¹ x in place with the factor of the last factored_jacobian (NaN if S was not positive definite), x in
+    the factor's order (solve_rows: in the rows').
 
     Both substitutions loop over the envelope only, O(envelope): the forward one along row i of L from first[i],
     the backward one down column i of L, over the rows k > i whose envelope reaches it (first[k] ≤ i) in ascending
@@ -139,7 +156,7 @@ def constrained_response(system, blocks, bodies, force, gamma):
     jacobian_times(blocks, bodies, scaled, lam)
     for r in range(lam.shape[0]):
         lam[r] -= gamma[r]
-    solve_factored(system, lam)
+    solve_rows(system, lam)
     reaction = system.solve_vector
     jacobian_transpose_times(blocks, bodies, lam, reaction)
     a = np.empty(n)
@@ -152,7 +169,7 @@ def constrained_response(system, blocks, bodies, force, gamma):
 def subtract_minimum_norm_correction(system, blocks, bodies, residual, x):
     """x −= M⁻¹Φ_qᵀ S⁻¹ r: the smallest change (in the M metric) that removes a constraint residual r, for the
     rows of the last factored_jacobian (residual is overwritten)."""
-    solve_factored(system, residual)
+    solve_rows(system, residual)
     correction = system.solve_vector
     jacobian_transpose_times(blocks, bodies, residual, correction)
     minv = system.inverse_mass

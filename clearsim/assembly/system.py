@@ -149,6 +149,7 @@ def _pinned_clearances(arrays: SystemArrays, clearances: list) -> SystemArrays:
     return arrays._replace(
         pin_bodies=np.vstack([arrays.pin_bodies, extra_bodies]),
         pin_points=np.vstack([arrays.pin_points, np.array(extra_points)]),
+        row_place=np.zeros(0, np.int64),  # the rows in their own places: the pins added shift the others
     )
 
 

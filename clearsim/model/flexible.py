@@ -304,12 +304,20 @@ def expanded_document(document: dict, mechanism, base_dir) -> dict:
     return expanded
 
 
+def rows_along_the_chain(mechanism):
+    """The mechanism of an expanded document (its joints chain_ordered), marked so that the assembly places each
+    joint's constraint rows together in that order (assembly/build.py)."""
+    mechanism._rows_along_the_chain = True
+    return mechanism
+
+
 def chain_ordered(joints: list[dict]) -> list[dict]:
     """The joints ordered along the chain: the bodies numbered by reverse Cuthill–McKee over "shares a joint", from
     the end where the file's first joint is, each joint at the highest number of its bodies (file order among
     equals). The constraint rows of joints that share a body then lie near each other in their groups (pins,
-    offsets, angles: assembly/arrays.py), so the envelope of S = Φ_q M⁻¹ Φ_qᵀ, which the Cholesky factor of every
-    right-hand side fills (assembly/dynamics.py), narrows; the split links' and beam segments' joints, appended by
+    offsets, angles: assembly/arrays.py), and each joint's rows together in the factor (rows_along_the_chain), so
+    the envelope of S = Φ_q M⁻¹ Φ_qᵀ, which the Cholesky factor of every right-hand side fills (assembly/dynamics.py),
+    narrows; the split links' and beam segments' joints, appended by
     the expansion, would otherwise reach back across all the rows (docs/performance.md, "Stiff models")."""
     from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import reverse_cuthill_mckee

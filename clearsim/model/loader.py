@@ -27,7 +27,7 @@ from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 from yaml.reader import ReaderError
 
 from clearsim.errors import InputError, Problem
-from clearsim.model.flexible import expanded_document, flexible_problems
+from clearsim.model.flexible import expanded_document, flexible_problems, rows_along_the_chain
 from clearsim.model.messages import show, validation_problems
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.paths import locate_error
@@ -525,8 +525,8 @@ def load_mechanism_text(text: str, name: str = "<string>", overrides: Sequence[s
         problems += check_references(mechanism) + duration_problems(mechanism)
         if not problems and any(body.flexible is not None for body in mechanism.bodies):
             problems += flexible_problems(mechanism)
-            mechanism = mechanism if problems else validate_mechanism(
-                expanded_document(document, mechanism, base_dir or Path.cwd()))
+            mechanism = mechanism if problems else rows_along_the_chain(validate_mechanism(
+                expanded_document(document, mechanism, base_dir or Path.cwd())))
     except ValidationError as exc:
         problems += validation_problems(exc, document, Mechanism) + _references_of_valid_part(document, exc)
     if problems:

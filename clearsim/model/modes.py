@@ -12,7 +12,8 @@ Bending mode of a beam link (and, in a model with beam links, the axial mode of 
 with every clearance joint closed, linearised (M_r = Tᵀ M T, K_r = Tᵀ ∇²V T, T an orthonormal basis of the null
 space of Φ_q, V the compiled potential energy; the constraint forces' geometric stiffness left out); a mode belongs
 to the flexible link whose springs (bending springs, or axial spring) store the largest share of its strain
-energy; the link's lowest such mode is reported.
+energy; the link's lowest such mode is reported, and its MODES_REPORTED lowest up to √2 × the highest contact
+frequency.
 
 Contact frequency of a clearance joint: 1/(2 t_c), t_c the Hertz contact duration of its contact episodes at their
 own impact speed and effective mass (their 5th–95th percentile range), or of an impact at 1 m/s with the reduced
@@ -33,6 +34,7 @@ from clearsim.whirl import hertz_text
 
 NEAR_FACTOR = math.sqrt(2.0)  # half an octave: a mode √2 above a forcing frequency transmits it with gain 1/(r² − 1)
 # ≤ 1 (the classical isolation limit), √2 below with gain 1/(1 − r²) ≤ 2; within the band it amplifies it
+MODES_REPORTED = 3  # per link: its lowest modes up to the contacts' band (the linearised model gives them at no cost)
 CONTACT_PERCENTILES = (5.0, 95.0)  # the range of the contacts' frequencies: most contacts, not a stray one
 
 
@@ -105,6 +107,11 @@ def axial_mode_frequencies(mechanism, links: list[str], base_dir) -> dict[str, f
     return frequencies
 
 
+def axial_link_modes(mechanism, links: list[str], base_dir) -> dict[str, list[float]]:
+    """axial_mode_frequencies as a list of modes per link: the link's spring, one mode (its slide's)."""
+    return {link: [mode] for link, mode in axial_mode_frequencies(mechanism, links, base_dir).items()}
+
+
 def linear_modes(system) -> tuple[np.ndarray, np.ndarray]:
     """(frequencies in Hz, mode shapes as columns of q) of the assembled system linearised at q0, at rest (module
     docstring); the Hessian of V by central differences, exact for the springs' quadratic energy."""
@@ -146,9 +153,9 @@ def strain_energies(system, link: str, shapes: np.ndarray) -> np.ndarray:
     return energy
 
 
-def linearised_mode_frequencies(mechanism, links: list[str], base_dir) -> dict[str, float]:
-    """Each flexible link's lowest mode of the linearised model (Hz): the lowest mode whose strain energy its
-    springs hold the largest share of, among `links` (module docstring); NaN when no mode is its."""
+def linearised_link_modes(mechanism, links: list[str], base_dir) -> dict[str, list[float]]:
+    """Each flexible link's modes of the linearised model (Hz, ascending): the modes whose strain energy its springs
+    hold the largest share of, among `links` (module docstring)."""
     from clearsim.assembly.system import assemble
 
     system = assemble(_closed_clearances(mechanism), base_dir)
@@ -157,7 +164,13 @@ def linearised_mode_frequencies(mechanism, links: list[str], base_dir) -> dict[s
     shares = np.array([strain_energies(system, link, shapes) / np.maximum(total, np.finfo(float).tiny)
                        for link in links]).reshape(len(links), -1)
     owner = np.argmax(shares, axis=0)
-    return {link: float(min(frequencies[owner == k], default=math.nan)) for k, link in enumerate(links)}
+    return {link: sorted(float(f) for f in frequencies[owner == k]) for k, link in enumerate(links)}
+
+
+def linearised_mode_frequencies(mechanism, links: list[str], base_dir) -> dict[str, float]:
+    """Each flexible link's lowest mode of the linearised model (Hz); NaN when no mode is its."""
+    return {link: modes[0] if modes else math.nan
+            for link, modes in linearised_link_modes(mechanism, links, base_dir).items()}
 
 
 def contact_frequencies(system, episodes) -> list[tuple[float, float]]:
@@ -177,41 +190,58 @@ def contact_frequencies(system, episodes) -> list[tuple[float, float]]:
     return ranges
 
 
-def mode_report(modes: dict[str, float], joints: list[JointFrequencies], kind: str = "axial") -> list[dict]:
-    """The `flexible_modes` attribute (as a list): per link its `kind` ("axial" or "bending") mode and what it is
-    near."""
-    return [{"link": link, f"{kind}_mode_hz": mode,
-             "near_contacts": [j.joint for j in joints if near(mode, *j.contacts)],
-             "near_whirls": [j.joint for j in joints if any(near(mode, w, w) for w in j.whirls)],
-             "contacts_hz": {j.joint: list(j.contacts) for j in joints},
-             "whirls_hz": {j.joint: list(j.whirls) for j in joints if j.whirls}}
-            for link, mode in modes.items()]
+def reported_modes(modes: list[float], joints: list[JointFrequencies]) -> list[float]:
+    """A link's modes the summary lists: its lowest MODES_REPORTED at or below √2 × the highest contact frequency
+    of any clearance joint (the top of the band where a mode is near a contact); the lowest alone when no joint
+    gives a contact frequency."""
+    if not joints:
+        return list(modes[:1])
+    ceiling = NEAR_FACTOR * max(j.contacts[1] for j in joints)
+    return [mode for mode in modes if mode <= ceiling][:MODES_REPORTED]
+
+
+def mode_report(modes: dict[str, list[float]], joints: list[JointFrequencies], kind: str = "axial") -> list[dict]:
+    """The `flexible_modes` attribute (as a list): per link its lowest `kind` ("axial" or "bending") mode and what
+    it is near, and under `modes` each reported mode (reported_modes) and what it is near; `modes` maps each link to
+    its modes (Hz, ascending; [NaN] when the model could not give them)."""
+    def nearby(mode: float) -> dict:
+        return {"near_contacts": [j.joint for j in joints if near(mode, *j.contacts)],
+                "near_whirls": [j.joint for j in joints if any(near(mode, w, w) for w in j.whirls)]}
+
+    def entry(link: str, frequencies: list[float]) -> dict:
+        lowest = frequencies[0] if frequencies else math.nan
+        return {"link": link, f"{kind}_mode_hz": lowest, **nearby(lowest),
+                "modes": [{"hz": mode, **nearby(mode)} for mode in reported_modes(frequencies, joints)],
+                "contacts_hz": {j.joint: list(j.contacts) for j in joints},
+                "whirls_hz": {j.joint: list(j.whirls) for j in joints if j.whirls}}
+
+    return [entry(link, frequencies) for link, frequencies in modes.items()]
 
 
 def flexible_modes_attribute(system, links: list[str], base_dir, episodes, whirls: dict,
                              beams: list[str] = ()) -> str:
     """The result file's `flexible_modes` (JSON, mode_report) of a run's system, its episode log and its joints'
-    whirls (clearsim.whirl.joint_whirls): the axial links' axial modes, then the beam links' lowest bending modes; a
+    whirls (clearsim.whirl.joint_whirls): the axial links' axial modes, then the beam links' bending modes; a
     mode is NaN when the model with closed clearance joints does not assemble."""
     joints = [JointFrequencies(joint, contacts, tuple(whirl.frequency for whirl in whirls.get(joint, ())))
               for joint, contacts in zip(system.clearance_joints, contact_frequencies(system, episodes))]
     if beams:  # the mobility of a slide with the other slides held would leave the beams' hinges free pins
-        modes = _modes_or_nan(linearised_mode_frequencies, system.mechanism, [*links, *beams], base_dir)
+        modes = _modes_or_nan(linearised_link_modes, system.mechanism, [*links, *beams], base_dir)
         axial, bending = {link: modes[link] for link in links}, {link: modes[link] for link in beams}
     else:
-        axial, bending = _modes_or_nan(axial_mode_frequencies, system.mechanism, list(links), base_dir), {}
+        axial, bending = _modes_or_nan(axial_link_modes, system.mechanism, list(links), base_dir), {}
     report = mode_report(axial, joints, "axial") + mode_report(bending, joints, "bending")
     return json.dumps(report)
 
 
-def _modes_or_nan(frequencies, mechanism, links: list[str], base_dir) -> dict[str, float]:
+def _modes_or_nan(frequencies, mechanism, links: list[str], base_dir) -> dict:
     from clearsim.assembly.build import BuildError
     from clearsim.errors import ClearsimError
 
     try:
         return frequencies(mechanism, links, base_dir)
     except (BuildError, ClearsimError, ValueError, np.linalg.LinAlgError):
-        return dict.fromkeys(links, math.nan)
+        return dict.fromkeys(links, [math.nan])
 
 
 def frequency_text(frequency: float) -> str:
@@ -227,13 +257,18 @@ def range_text(lowest: float, highest: float) -> str:
     return f"{frequency_text(lowest)} – {frequency_text(highest)}"
 
 
+def _nearby_text(entry: dict) -> str:
+    nearby = [f"joint {j}'s contacts" for j in entry["near_contacts"]]
+    nearby += [f"joint {j}'s whirl" for j in entry["near_whirls"]]
+    return " and ".join(nearby)
+
+
 def mode_lines(attribute: str) -> list[str]:
     """One line per flexible link from the `flexible_modes` attribute, e.g. "flexible link pole: axial mode 412 Hz,
-    near nothing (within √2); joint J: contacts 6–8 kHz, whirl 2.1 kHz" ("bending mode" for a beam link)."""
+    near nothing (within √2); joint J: contacts 6–8 kHz, whirl 2.1 kHz" ("bending mode" for a beam link), with its
+    higher reported modes after the lowest: "higher modes 2.1 kHz (near joint J's contacts), 3.2 kHz"."""
     lines = []
     for entry in json.loads(attribute) if attribute else []:
-        nearby = [f"joint {j}'s contacts" for j in entry["near_contacts"]]
-        nearby += [f"joint {j}'s whirl" for j in entry["near_whirls"]]
         joints = []
         for joint, contacts in entry["contacts_hz"].items():
             whirls = entry["whirls_hz"].get(joint, [])
@@ -241,6 +276,8 @@ def mode_lines(attribute: str) -> list[str]:
                           + "".join(f", whirl {frequency_text(w)}" for w in whirls))
         kind = "axial" if "axial_mode_hz" in entry else "bending"
         head = (f"flexible link {entry['link']}: {kind} mode {frequency_text(entry[f'{kind}_mode_hz'])}, near "
-                f"{' and '.join(nearby) if nearby else 'no contact or whirl frequency'} (within ×√2)")
-        lines.append("; ".join([head] + joints))
+                f"{_nearby_text(entry) or 'no contact or whirl frequency'} (within ×√2)")
+        higher = [frequency_text(mode["hz"]) + (f" (near {_nearby_text(mode)})" if _nearby_text(mode) else "")
+                  for mode in entry.get("modes", [])[1:]]  # the reported modes begin with the lowest
+        lines.append("; ".join([head] + ([f"higher modes {', '.join(higher)}"] if higher else []) + joints))
     return lines

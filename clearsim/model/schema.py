@@ -14,8 +14,8 @@ from typing import Annotated, Literal, Union
 
 import numpy as np
 
-from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, ValidationInfo, \
-    WithJsonSchema, field_validator, model_validator
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr, ValidationError, \
+    ValidationInfo, WithJsonSchema, field_validator, model_validator
 
 from clearsim.units import (
     BASE_UNITS,
@@ -1049,6 +1049,13 @@ class Mechanism(Strict):
     solver: SolverSettings
     tolerances: list[Tolerance] = Field(
         default_factory=list, description="random distributions of values for `clearsim sweep --sample N`; ignored by `run`")
+    # set on a flexible file's expansion (model/flexible.py), whose joints are in chain order: the assembly places its
+    # constraint rows joint by joint in that order (assembly/build.py, arrays.row_place)
+    _rows_along_the_chain: bool = PrivateAttr(False)
+
+    @property
+    def rows_along_the_chain(self) -> bool:
+        return self._rows_along_the_chain
 
     @model_validator(mode="after")
     def _raw_quantities_in_declared_units(self, info: ValidationInfo):

@@ -73,11 +73,12 @@ FIELD_LAYOUT = {
     "torsion_bodies": ("i8", 2), "torsion_params": ("f8", 2),
     "hydraulic_bodies": ("i8", 2), "hydraulic_params": ("f8", 2), "hydraulic_laws": ("i8", 2),
     "wear_harmonics": ("i8", 1), "wear_profile": ("f8", 2), "wear_depth_range": ("f8", 1), "wear_slots": ("i8", 2), "wear_rates": ("f8", 2),
+    "row_place": ("i8", 1),
     "inverse_mass": ("f8", 1), "solve_blocks": ("f8", 3), "solve_bodies": ("i8", 2), "solve_schur": ("f8", 2),
     "solve_lower": ("f8", 2), "solve_envelope": ("i8", 1), "solve_band": ("i8", 1),
     "solve_next_row": ("i8", 1), "solve_body_start": ("i8", 1),
     "solve_entries": ("i8", 2), "solve_body_fill": ("i8", 1), "solve_vector": ("f8", 1),
-    "solve_residual": ("f8", 1), "factor_key": ("i8", 1), "factor_q": ("f8", 1),
+    "solve_residual": ("f8", 1), "solve_place": ("i8", 1), "solve_placed": ("f8", 1), "factor_key": ("i8", 1), "factor_q": ("f8", 1),
 }
 
 _helper: subprocess.Popen | None = None

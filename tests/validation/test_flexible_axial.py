@@ -123,11 +123,13 @@ def test_the_flexible_slider_crank_closes_the_energy_balance(simulate, overrides
 
 
 def test_the_flexible_slider_crank_tends_to_the_rigid_one_as_the_rod_stiffens(simulate):
+    """Peak contact force against the rigid rod's 45.60 kN: −4.3 % at 1e10 N/m, −0.27 % at 1000× a steel rod's
+    1.7e8 N/m, −0.042 % at 1e12 N/m (≈ 6000×)."""
     rigid = np.max(simulate("slider_crank_flores.yaml")["sensors/pin_normal_force"])
     errors = [abs(np.max(simulate(flores_with_flexible_rod(f"{{model: axial, axial_stiffness: {k:g} N/m}}"))
-                         ["sensors/pin_normal_force"]) / rigid - 1) for k in (1e10, 1e12)]
-    assert errors[1] <= 5e-3  # ≈ 6000× a steel rod's 1.7e8 N/m
-    assert errors[1] < errors[0]  # converging
+                         ["sensors/pin_normal_force"]) / rigid - 1) for k in (1e10, 1.7e11, 1e12)]
+    assert errors[1] <= 5e-3 and errors[2] <= 5e-3  # 1000× and ≈ 6000× the steel rod
+    assert errors[2] < errors[1] < errors[0]  # converging
 
 
 def test_loads_and_sensors_on_the_links_own_points_follow_its_ends(simulate, tmp_path):

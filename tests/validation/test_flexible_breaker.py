@@ -166,3 +166,21 @@ def test_the_summary_gives_each_crank_arms_lowest_bending_mode(runs_at_10_microm
     assert pole < POLE_MODE_AXIAL_CHAIN  # the arms' bending compliance can only lower it (Rayleigh)
     assert {f"flexible link {link}: bending mode" for link in BEAM_LINKS} <= \
            {line.split(" mode ")[0] + " mode" for line in mode_lines(attribute)}
+
+
+def test_the_summary_lists_the_crank_arms_higher_modes_up_to_the_contacts(runs_at_10_micrometres):
+    """Each arm's modes of the linearised chain up to √2 × the highest contact frequency, lowest first, at most three:
+    the lower turn arm's 559 Hz, 2.1 kHz, 4.6 kHz; the main crank arm's 388 Hz, 3.2 kHz, 6.7 kHz (A's contacts reach
+    4.7 kHz)."""
+    import json
+    import math
+
+    from clearsim.model.modes import MODES_REPORTED, NEAR_FACTOR
+
+    report = {entry["link"]: entry for entry in json.loads(runs_at_10_micrometres[FLEXIBLE][1])}
+    ceiling = NEAR_FACTOR * max(high for _, high in report[BEAM_LINKS[0]]["contacts_hz"].values())
+    for link in BEAM_LINKS:
+        listed = [mode["hz"] for mode in report[link]["modes"]]
+        assert 1 < len(listed) <= MODES_REPORTED
+        assert listed == sorted(listed) and listed[0] == report[link]["bending_mode_hz"]
+        assert all(math.isfinite(mode) and mode <= ceiling for mode in listed)

@@ -1,21 +1,25 @@
-"""The flexible links' axial modes and what they are near (clearsim.model.modes): the mode of a mass on a link, and
-of two links in series each with the other held, against their closed forms; the "near" classification on
-constructed numbers; the run's summary line and `flexible_modes` attribute, there for a flexible model only."""
+"""The flexible links' modes and what they are near (clearsim.model.modes): the axial mode of a mass on a link, and
+of two links in series each with the other held, against their closed forms; a simply supported beam link's bending
+modes against Euler–Bernoulli; the "near" classification and the modes listed on constructed numbers; the run's
+summary line and `flexible_modes` attribute, there for a flexible model only."""
 
 import json
 import math
 
+import numpy as np
 import pytest
+import yaml
 from typer.testing import CliRunner
 
 from clearsim.cli import app
 from clearsim.io.hdf5 import read_result
 from clearsim.model.loader import load_mechanism_text
 from clearsim.model.flexible import flexible_link_names
-from clearsim.model.modes import (JointFrequencies, axial_mode_frequencies, mode_lines,
-                                  mode_report, near)
+from clearsim.model.modes import (MODES_REPORTED, JointFrequencies, axial_mode_frequencies,
+                                  linearised_link_modes, mode_lines, mode_report, near, reported_modes)
 
 from tests.validation.test_flexible_axial import LINK, OMEGA, PERIOD, STIFFNESS, TIP, mass_on_link
+from tests.validation.test_flexible_beam import BENDING, LENGTH, MASS_PER_LENGTH, cantilever
 
 # two links in series along x, O–A and A–B, pinned to ground at O, a mass M pinned at B; no gravity. With the second
 # link held rigid the first one's slide carries its own far half, the whole second link and M: m_eff = m₁/2 + m₂ + M;
@@ -67,12 +71,76 @@ def test_a_mode_is_near_a_frequency_range_within_a_factor_of_the_square_root_of_
 
 def test_the_report_names_the_joints_whose_contacts_or_whirl_lie_near_each_mode():
     joints = [JointFrequencies("J", (6000.0, 8000.0), (2100.0,)), JointFrequencies("A", (900.0, 1200.0), ())]
-    report = mode_report({"pole": 412.0, "board": 1600.0}, joints)
+    report = mode_report({"pole": [412.0], "board": [1600.0]}, joints)
     assert [(entry["near_contacts"], entry["near_whirls"]) for entry in report] == [([], []), (["A"], ["J"])]
     lines = mode_lines(json.dumps(report))
     assert lines[0] == ("flexible link pole: axial mode 412 Hz, near no contact or whirl frequency (within ×√2); "
                         "joint J: contacts 6–8 kHz, whirl 2.1 kHz; joint A: contacts 900 Hz – 1.2 kHz")
     assert lines[1].startswith("flexible link board: axial mode 1.6 kHz, near joint A's contacts and joint J's whirl")
+
+
+# the cantilever of test_flexible_beam.py unclamped and carried at x = L by a roller (a slider on a horizontal guide):
+# simply supported, its bending modes ω_k = (kπ)² √(E I/(ρ A L⁴)); the roller's mass moves only along the axis, which
+# the inextensible chain holds still to first order
+SUPPORTED_MODES = (np.array([1, 2, 3]) * math.pi) ** 2 * math.sqrt(
+    BENDING / (MASS_PER_LENGTH * LENGTH ** 4)) / (2 * math.pi)  # Hz: 15.7, 62.8, 141
+
+
+def simply_supported(segments: int) -> str:
+    document = yaml.safe_load(cantilever(f", segments: {segments}"))
+    del document["drivers"], document["sensors"]
+    document["bodies"].append({"name": "roller", "mass": 0.01, "inertia": 1e-6, "position": [LENGTH, 0]})
+    document["joints"] += [{"name": "end", "type": "revolute", "bodies": ["beam", "roller"], "at": [LENGTH, 0]},
+                           {"name": "guide", "type": "prismatic", "bodies": ["ground", "roller"], "at": [LENGTH, 0],
+                            "axis": [1, 0]}]
+    return yaml.safe_dump(document)
+
+
+def supported_beam_errors(segments: int) -> np.ndarray:
+    """The relative errors of the simply supported beam link's three lowest modes as linearised_link_modes gives
+    them, cut into `segments` elements."""
+    loaded = load_mechanism_text(simply_supported(segments))
+    modes = linearised_link_modes(loaded.mechanism, ["beam"], loaded.base_dir)["beam"]
+    assert len(modes) == segments  # n hinges between two supports: n transverse modes, every one the beam's
+    return np.array(modes[:3]) / SUPPORTED_MODES - 1
+
+
+def test_a_simply_supported_beam_links_modes_match_euler_bernoulli_and_converge():
+    """At the default n = 10: −6.9·10⁻⁶, −1.2·10⁻⁴, −6.7·10⁻⁴ (the pinned ends sit on the springs' symmetric pattern,
+    so the error falls as 1/n⁴, 16× per doubling, where a cantilever's falls as 1/n²)."""
+    errors = np.array([supported_beam_errors(n) for n in (5, 10, 20)])
+    assert np.all(np.abs(errors[1]) <= 1e-3)
+    assert np.all(np.abs(errors[1:]) * 8 < np.abs(errors[:-1]))
+
+
+def test_the_modes_listed_are_the_lowest_few_up_to_the_contacts_band():
+    joints = [JointFrequencies("J", (2000.0, 3000.0), ()), JointFrequencies("A", (900.0, 1200.0), ())]
+    ceiling = math.sqrt(2) * 3000.0  # 4243 Hz: the top of the band near the highest contact frequency
+    assert reported_modes([559.0, 2143.0, 4200.0, 4300.0], joints) == [559.0, 2143.0, 4200.0]
+    assert reported_modes([100.0, 200.0, 300.0, 400.0], joints) == [100.0, 200.0, 300.0][:MODES_REPORTED]
+    assert reported_modes([ceiling * 1.01, ceiling * 2], joints) == []
+    assert reported_modes([559.0, 2143.0], []) == [559.0]  # no clearance joint: the lowest mode
+
+
+def test_the_report_and_the_summary_line_give_each_listed_mode_and_what_it_is_near():
+    joints = [JointFrequencies("J", (2000.0, 3000.0), (2100.0,)), JointFrequencies("A", (900.0, 1200.0), ())]
+    report = mode_report({"arm": [559.0, 2143.0, 3199.0, 6658.0]}, joints, "bending")
+    assert report[0]["bending_mode_hz"] == 559.0 and report[0]["near_contacts"] == []
+    assert [(m["hz"], m["near_contacts"], m["near_whirls"]) for m in report[0]["modes"]] == [
+        (559.0, [], []), (2143.0, ["J"], ["J"]), (3199.0, ["J"], [])]
+    assert mode_lines(json.dumps(report))[0] == (
+        "flexible link arm: bending mode 559 Hz, near no contact or whirl frequency (within ×√2); higher modes "
+        "2.1 kHz (near joint J's contacts and joint J's whirl), 3.2 kHz (near joint J's contacts); "
+        "joint J: contacts 2–3 kHz, whirl 2.1 kHz; joint A: contacts 900 Hz – 1.2 kHz")
+
+
+def test_a_summary_attribute_without_the_modes_list_still_gives_its_line():
+    """A result file written before `modes` was listed: the lowest mode's line as before."""
+    entry = {"link": "pole", "axial_mode_hz": 412.0, "near_contacts": [], "near_whirls": [],
+             "contacts_hz": {"J": [6000.0, 8000.0]}, "whirls_hz": {}}
+    assert mode_lines(json.dumps([entry])) == [
+        "flexible link pole: axial mode 412 Hz, near no contact or whirl frequency (within ×√2); "
+        "joint J: contacts 6–8 kHz"]
 
 
 def run_cli(tmp_path, text: str):
@@ -88,6 +156,7 @@ def test_the_run_summary_and_the_file_give_each_flexible_links_mode(tmp_path):
     report = json.loads(attributes["flexible_modes"])
     assert [entry["link"] for entry in report] == ["link"]
     assert report[0]["axial_mode_hz"] == pytest.approx(1 / PERIOD, rel=1e-9)
+    assert [mode["hz"] for mode in report[0]["modes"]] in ([], [report[0]["axial_mode_hz"]])
     assert "flexible link link: axial mode 71.2 Hz" in " ".join(printed.split())
 
 

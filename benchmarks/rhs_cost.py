@@ -9,8 +9,9 @@ the loop, divided by `count`). "At a new q" alternates between that state and th
 positions away, so that every call factors S again as a stage of a step does; "at the same q" keeps the factor of the
 previous call (the right-hand side at a step's end, after the projection). The parts are timed on their own, so their
 sum differs from the whole by what the kernels share (the arrays in cache) and by the glue (copies, allocations).
-The loop's counters of the whole run split the right-hand sides: six a try, tries rejected, and the rest (first
-steps after a mode switch, event refinement, samples, the step end's rhs).
+The loop's counters of the whole run split the right-hand sides: six a try (accepted or rejected), one at each step's
+end (after the projection), and the rest (the right-hand side after a mode switch, the step integrated again to an
+event).
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from clearsim.assembly.constraints import (
 )
 from clearsim.assembly.drivelines import add_driveline_forces, driveline_powers
 from clearsim.assembly.dynamics import (
-    FACTOR_SPD, STICK, WORK_COUNT, accelerations, constrained_response, driver_power, factored_jacobian, factorize,
+    STICK, WORK_COUNT, accelerations, constrained_response, driver_power, factored_jacobian, factorize,
     rhs, solve_factored, stick_count,
 )
 from clearsim.assembly.forces import add_applied_forces, add_clearance_forces, add_wear_rates, stick_row
@@ -297,14 +298,14 @@ def breakdown(run, system, dynamics, count: int = 20000, repeats: int = 7) -> di
             "parts_us": parts, "parts_sum_us": sum(parts.values())}
 
 
-def rhs_accounting(config: Path) -> dict:
-    """The run's right-hand sides: six a try (accepted and rejected), and the rest."""
+def rhs_accounting(config: Path, overrides: list[str] | None = None) -> dict:
+    """The run's right-hand sides: six a try (accepted and rejected), one at each step's end, and the rest."""
     from clearsim.runner import prepare
     from clearsim.model.loader import load_mechanism
     from clearsim.solver import integrator as ig
     from clearsim.solver.simulate import Run
 
-    run = Run(prepare(load_mechanism(config, [])))
+    run = Run(prepare(load_mechanism(config, overrides or [])))
     for _ in run.chunks():
         pass
     steps, rejected, evaluations = (int(run.ints[i]) for i in (ig.I_STEPS, ig.I_REJECTED, ig.I_RHS))

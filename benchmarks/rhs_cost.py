@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from numba import njit
+from numba import njit, typeof, types
 
 from clearsim.assembly.constraints import (
     constraint_count, evaluate_acceleration_rhs, evaluate_jacobian_blocks, jacobian_times, jacobian_transpose_times,
@@ -30,8 +30,8 @@ from clearsim.assembly.constraints import (
 )
 from clearsim.assembly.drivelines import add_driveline_forces, driveline_powers
 from clearsim.assembly.dynamics import (
-    STICK, WORK_COUNT, accelerations, constrained_response, driver_power, factored_jacobian, factorize,
-    rhs, solve_factored, stick_count,
+    STICK, WORK_COUNT, accelerations, constrained_response, driver_power, dynamics_type, factored_jacobian,
+    factorize, rhs, solve_factored, stick_count,
 )
 from clearsim.assembly.forces import add_applied_forces, add_clearance_forces, add_wear_rates, stick_row
 from clearsim.assembly.hydraulics import add_hydraulic_forces, hydraulic_rates
@@ -56,13 +56,22 @@ def state_at(config: Path, t_state: float, overrides: list[str] | None = None):
     return run, run.kernel_arrays, ig.addressed(ig.DOPRI5, run.lubricated)[2]
 
 
-@njit
-def _time_rhs(system, dynamics, t, ya, yb, modes, speeds, ydot, count):
+def _rhs_calls(system, dynamics, t, ya, yb, modes, speeds, ydot, count):
     total = 0.0
     for i in range(count):
         rhs(system, dynamics, t, ya if i % 2 == 0 else yb, modes, speeds, ydot)
         total += ydot[0]
     return total
+
+
+def _rhs_timer(system):
+    """_rhs_calls compiled with the dynamics by address, as the loop calls it (a dynamics passed as a dispatcher would
+    compile, and cache, rhs once more for the dispatcher's type)."""
+    real, vector, integers = types.float64, types.float64[::1], types.int64[::1]
+    system_type = typeof(system)
+    signature = real(system_type, dynamics_type(system_type), real, vector, vector, integers, vector, vector,
+                     types.int64)
+    return njit(signature)(_rhs_calls)
 
 
 @njit
@@ -174,14 +183,10 @@ def _refine(system, blocks, bodies, b, lam, product, residual, tolerance, max_it
     """λ of S(q) λ = b with S's factor of another q (the scratch's) by iterative refinement, S products matrix-free
     (Φ_q M⁻¹ Φ_qᵀ x from the blocks at q); returns the refinements made until one changes λ by at most tolerance
     max |λ| (round-off: the residual itself cannot fall below ≈ ε ‖S‖ ‖λ‖)."""
-    minv = system.inverse_mass
     lam[:] = b
     solve_factored(system, lam)
     for iteration in range(max_iterations):
-        jacobian_transpose_times(blocks, bodies, lam, product)
-        for i in range(product.shape[0]):
-            product[i] *= minv[i]
-        jacobian_times(blocks, bodies, product, residual)
+        _schur_times(system, blocks, bodies, lam, product, residual)
         for r in range(residual.shape[0]):
             residual[r] = b[r] - residual[r]
         solve_factored(system, residual)
@@ -196,8 +201,63 @@ def _refine(system, blocks, bodies, b, lam, product, residual, tolerance, max_it
 
 
 @njit
-def _time_refined(system, q_old, q_new, qd, modes, b, tolerance, count):
-    """A stage's multipliers with the factor of the step's start kept: the blocks at the stage's q, then _refine."""
+def _schur_times(system, blocks, bodies, x, product, out):
+    """out = Φ_q M⁻¹ Φ_qᵀ x from the blocks (product: scratch of the coordinates' size)."""
+    minv = system.inverse_mass
+    jacobian_transpose_times(blocks, bodies, x, product)
+    for i in range(product.shape[0]):
+        product[i] *= minv[i]
+    jacobian_times(blocks, bodies, product, out)
+
+
+@njit
+def _conjugate_gradients(system, blocks, bodies, b, lam, product, tolerance, max_iterations):
+    """λ of S(q) λ = b by conjugate gradients preconditioned with S's factor of another q (the scratch's), S products
+    matrix-free; returns the iterations made until one changes λ by at most tolerance max |λ|."""
+    m = b.shape[0]
+    lam[:] = b
+    solve_factored(system, lam)
+    residual, preconditioned, direction, image = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
+    _schur_times(system, blocks, bodies, lam, product, image)
+    for r in range(m):
+        residual[r] = b[r] - image[r]
+    preconditioned[:] = residual
+    solve_factored(system, preconditioned)
+    direction[:] = preconditioned
+    rho = 0.0
+    for r in range(m):
+        rho += residual[r] * preconditioned[r]
+    for iteration in range(max_iterations):
+        _schur_times(system, blocks, bodies, direction, product, image)
+        curvature = 0.0
+        for r in range(m):
+            curvature += direction[r] * image[r]
+        if curvature <= 0.0:
+            return iteration
+        alpha = rho / curvature
+        change, size = 0.0, 0.0
+        for r in range(m):
+            lam[r] += alpha * direction[r]
+            residual[r] -= alpha * image[r]
+            change = max(change, abs(alpha * direction[r]))
+            size = max(size, abs(lam[r]))
+        if change <= tolerance * size:
+            return iteration + 1
+        preconditioned[:] = residual
+        solve_factored(system, preconditioned)
+        rho_next = 0.0
+        for r in range(m):
+            rho_next += residual[r] * preconditioned[r]
+        for r in range(m):
+            direction[r] = preconditioned[r] + rho_next / rho * direction[r]
+        rho = rho_next
+    return max_iterations
+
+
+@njit
+def _time_refined(system, q_old, q_new, qd, modes, b, tolerance, count, gradients=False):
+    """A stage's multipliers with the factor of the step's start kept: the blocks at the stage's q, then _refine (or
+    _conjugate_gradients)."""
     m = constraint_count(system)
     factored_jacobian(system, q_old, qd, modes, m, np.zeros(m))
     blocks, bodies = np.zeros((m, 2, 3)), np.zeros((m, 2), np.int64)
@@ -205,7 +265,10 @@ def _time_refined(system, q_old, q_new, qd, modes, b, tolerance, count):
     iterations = 0
     for _ in range(count):
         evaluate_jacobian_blocks(system, q_new, blocks, bodies)
-        iterations += _refine(system, blocks, bodies, b, lam, product, residual, tolerance, 50)
+        if gradients:
+            iterations += _conjugate_gradients(system, blocks, bodies, b, lam, product, tolerance, 50)
+        else:
+            iterations += _refine(system, blocks, bodies, b, lam, product, residual, tolerance, 50)
     return iterations / count, lam
 
 
@@ -225,9 +288,9 @@ def _time_fresh(system, q_old, q_new, qd, modes, b, count):
 
 
 def refinement(run, system, steps=(1e-6, 1e-5, 1e-4), count: int = 5000, repeats: int = 5) -> dict:
-    """The multipliers of a stage a step h away (q + h q̇) with the factor of the step's start kept: refinements to
-    round-off (the last one changes λ by ≤ 4 ε max |λ|), µs per solve against forming and factoring S anew, and how far λ lands
-    from the fresh solve's."""
+    """The multipliers of a stage a step h away (q + h q̇) with the factor of the step's start kept: refinements (and
+    preconditioned conjugate gradients) to round-off (the last one changes λ by ≤ 4 ε max |λ|), µs per solve against
+    forming and factoring S anew, and how far λ lands from the fresh solve's."""
     n = run.coordinate_count
     q, qd = run.y[:n].copy(), run.y[n:2 * n].copy()
     modes = np.zeros_like(run.modes)  # Φ's rows
@@ -237,7 +300,13 @@ def refinement(run, system, steps=(1e-6, 1e-5, 1e-4), count: int = 5000, repeats
         q_new = q + h * qd
         iterations, refined = _time_refined(system, q, q_new, qd, modes, b, 4 * np.finfo(float).eps, 1)
         fresh = _time_fresh(system, q, q_new, qd, modes, b, 1)
+        gradient_iterations, gradients = _time_refined(system, q, q_new, qd, modes, b, 4 * np.finfo(float).eps, 1,
+                                                       True)
         rows[f"{h:g}"] = {
+            "cg_iterations": gradient_iterations,
+            "cg_us": _microseconds(lambda c: _time_refined(system, q, q_new, qd, modes, b, 4 * np.finfo(float).eps, c,
+                                                           True), count, repeats),
+            "cg_relative_difference": float(np.max(np.abs(gradients - fresh)) / np.max(np.abs(fresh))),
             "iterations": iterations,
             "refined_us": _microseconds(lambda c: _time_refined(system, q, q_new, qd, modes, b,
                                                                 4 * np.finfo(float).eps, c), count, repeats),
@@ -268,9 +337,10 @@ def breakdown(run, system, dynamics, count: int = 20000, repeats: int = 7) -> di
     m = constraint_count(system)
     rows = m + int(np.sum(modes == STICK))
     blocks, bodies = np.zeros((m, 2, 3)), np.zeros((m, 2), np.int64)
-    rhs_new = _microseconds(lambda c: _time_rhs(system, dynamics, t, y, other, modes, speeds, ydot, c), count, repeats)
-    rhs_same = _microseconds(lambda c: _time_rhs(system, dynamics, t, y, y, modes, speeds, ydot, c), count, repeats)
-    _time_rhs(system, dynamics, t, y, y, modes, speeds, ydot, 1)
+    time_rhs = _rhs_timer(system)
+    rhs_new = _microseconds(lambda c: time_rhs(system, dynamics, t, y, other, modes, speeds, ydot, c), count, repeats)
+    rhs_same = _microseconds(lambda c: time_rhs(system, dynamics, t, y, y, modes, speeds, ydot, c), count, repeats)
+    time_rhs(system, dynamics, t, y, y, modes, speeds, ydot, 1)
     force = np.zeros(n)
     force[:] = ydot[n:2 * n]  # any force will do for the timing
     gamma = np.zeros(rows)

@@ -140,11 +140,12 @@ def dense_jacobian(system, q: np.ndarray) -> np.ndarray:
 def jacobian_times(blocks, bodies, x, out):
     """out = Φ_q x."""
     for row in range(blocks.shape[0]):
-        out[row] = 0.0
+        value = 0.0  # summed in a register: out may alias x as far as LLVM knows
         for slot in range(2):
             b = bodies[row, slot]
             if b >= 0:
-                out[row] += blocks[row, slot, 0] * x[3 * b] + blocks[row, slot, 1] * x[3 * b + 1] + blocks[row, slot, 2] * x[3 * b + 2]
+                value += blocks[row, slot, 0] * x[3 * b] + blocks[row, slot, 1] * x[3 * b + 1] + blocks[row, slot, 2] * x[3 * b + 2]
+        out[row] = value
 
 
 @njit(cache=True)

@@ -109,7 +109,8 @@ def solve_factored(system, x):
     Both substitutions loop over the envelope only, O(envelope): the forward one along row i of L from first[i],
     the backward one down column i of L, over the rows k > i whose envelope reaches it (first[k] ≤ i) in ascending
     order. Those rows are a linked list (system.solve_next_row) kept while i descends: row i + 1 joins at its head,
-    a row leaves when i passes its first column, and never comes back.
+    a row leaves when i passes its first column, and never comes back. Each sum runs in a register (not x[i] in
+    memory, which LLVM cannot keep apart from the x[k] read: ≈ 1.6× the time), subtracting in the same order.
     """
     m = x.shape[0]
     if system.factor_key[0] != FACTOR_SPD:
@@ -119,9 +120,10 @@ def solve_factored(system, x):
     first = system.solve_envelope
     lower = system.solve_lower
     for i in range(m):
+        value = x[i]
         for k in range(first[i], i):
-            x[i] -= lower[i, k] * x[k]
-        x[i] /= lower[i, i]
+            value -= lower[i, k] * x[k]
+        x[i] = value / lower[i, i]
     following = system.solve_next_row
     head = -1  # the first row of the list, −1: empty; following[k]: the row after k
     for i in range(m - 1, -1, -1):
@@ -130,6 +132,7 @@ def solve_factored(system, x):
             head = i + 1
         previous = -1
         k = head
+        value = x[i]
         while k >= 0:
             after = following[k]
             if first[k] > i:
@@ -138,10 +141,10 @@ def solve_factored(system, x):
                 else:
                     following[previous] = after
             else:
-                x[i] -= lower[k, i] * x[k]
+                value -= lower[k, i] * x[k]
                 previous = k
             k = after
-        x[i] /= lower[i, i]
+        x[i] = value / lower[i, i]
 
 
 @njit(cache=True)

@@ -30,7 +30,7 @@ from clearsim.assembly.kinematics import (
 from clearsim.assembly.constraints import prescribed
 from clearsim.assembly.drivelines import driveline_potential
 from clearsim.physics.contact import damped_force
-from clearsim.physics.cylindrical import law_state
+from clearsim.physics.cylindrical import law_force, law_state
 from clearsim.physics.friction import STICK_EXACT, friction_coefficient, sliding_coefficient
 from clearsim.physics.lubrication import film_force, film_torque, line_of_centres
 from clearsim.physics.wear import add_band_rates, band_half_angle, bore_curvature_radius, closest_bore_point
@@ -162,8 +162,7 @@ def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact
         return 0.0, 0.0, 0.0
     p = system.clearance_params[k]
     guarded_speed = max(impact_speed, p[CL_MIN_IMPACT_SPEED])  # grazing guard, docs/model.md
-    elastic = law_state(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT],
-                        p[CL_CLEARANCE])[0]
+    elastic = law_force(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT], p[CL_CLEARANCE])
     force = damped_force(system.clearance_laws[k, 0], elastic, rate, guarded_speed, p[CL_RESTITUTION])
     law = system.clearance_laws[k, 1]
     if not exact_stick(system, k):

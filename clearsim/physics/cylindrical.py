@@ -206,6 +206,15 @@ def law_state(law, penetration, stiffness, exponent, clearance):
             power_energy(penetration, stiffness, exponent))
 
 
+@njit(cache=True)
+def law_force(law, penetration, stiffness, exponent, clearance):
+    """F_el alone: law_state(…)[0], for the power laws without the stiffness and energy law_state also computes (two
+    powers fewer a contact force, the right-hand side's; bit for bit the same force)."""
+    if penetration > 0.0 and is_power_law(law):
+        return power_force(penetration, stiffness, exponent)
+    return law_state(law, penetration, stiffness, exponent, clearance)[0]
+
+
 @njit(cache=True, inline="always")
 def is_power_law(law):
     """F_el = K δⁿ (point_hertz, pereira): the closed-form Hertz estimates apply."""

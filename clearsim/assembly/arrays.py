@@ -212,7 +212,6 @@ def blas_hidden():
         del sys.modules[name]
 
 
-
 @njit(cache=True, inline="always")
 def copy_into(out, values):
     """out[...] = values element by element (1-D): a slice assignment would compile numba's shape-mismatch

@@ -88,6 +88,12 @@ def component_name(system, index: int) -> str:
     return f"state[{index}]"
 
 
+def no_jacobian_taken(modes: np.ndarray) -> np.ndarray:
+    """evaluate_jacobian's record for a first Jacobian: the modes it was taken in, the Jacobians taken since (0: none,
+    so it takes every column) and the rhs evaluations it made — two slots after the modes, which it writes."""
+    return np.zeros(modes.size + 2, np.int64)
+
+
 def jacobian_stability(arrays, dynamics, t, y, f, h, tried, modes, speeds, n, floor) -> dict:
     """The whole system's picture: eigenvalues of the finite-difference ∂f/∂y of q, q̇ (rosenbrock's), the largest
     h·|λ| and max |R(hλ)| over them at the accepted and at the first-tried step."""
@@ -95,7 +101,8 @@ def jacobian_stability(arrays, dynamics, t, y, f, h, tried, modes, speeds, n, fl
     from clearsim.solver.rosenbrock import evaluate_jacobian
 
     jacobian = np.zeros((y.size, y.size + 1))
-    evaluate_jacobian(arrays, dynamics, t, y, f, h, modes, speeds, 2 * n, WORK_COUNT, floor, jacobian, modes.copy())
+    evaluate_jacobian(arrays, dynamics, t, y, f, h, modes, speeds, 2 * n, WORK_COUNT, floor, jacobian,
+                      no_jacobian_taken(modes))
     eigenvalues = np.linalg.eigvals(jacobian[:2 * n, :2 * n])
     fastest = eigenvalues[np.argmax(np.abs(eigenvalues))]
     return {"jac_h_lambda": float(h * abs(fastest)), "jac_fastest_real": float(fastest.real),

@@ -1,0 +1,28 @@
+"""`python -m benchmarks.step_trace --jacobian-every N` hands rosenbrock's evaluate_jacobian a record of the modes
+with the two slots it reads and writes after them (the Jacobians taken since, its rhs evaluations): the process ends
+with exit code 0, and every sampled Jacobian has all its columns, so the whole system's h·max|λ| is not zero."""
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+REPOSITORY = Path(__file__).resolve().parents[2]
+FLEXIBLE = REPOSITORY / "clearsim" / "configs" / "uhv_breaker_flexible.yaml"
+
+
+def run_step_trace(*arguments: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "benchmarks.step_trace", *arguments], cwd=REPOSITORY,
+                          capture_output=True, text=True, timeout=600)
+
+
+def test_the_flexible_breakers_trace_with_jacobians_exits_cleanly():
+    result = run_step_trace("--config", str(FLEXIBLE), "--set", "joints.A.clearance=0.1mm",
+                            "--set", "joints.J.clearance=0.1mm", "--set", "solver.t_end=5ms", "--jacobian-every", "50")
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert "free()" not in result.stderr
+    sampled = re.search(r"whole-system Jacobian at (\d+) steps: h·max\|λ\| median ([0-9.e+-]+), 90 % ([0-9.e+-]+)",
+                        result.stdout)
+    assert sampled, result.stdout
+    assert int(sampled[1]) > 1
+    assert float(sampled[2]) > 0.0 and float(sampled[3]) > 0.0

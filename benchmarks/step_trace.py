@@ -25,22 +25,43 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
-from numba import njit
+from numba import njit, typeof, types
 
 from clearsim.solver.dopri import MATRIX, STAGES, WEIGHTS, step
+from clearsim.solver.rosenbrock import evaluate_jacobian
 
 UHV = Path(__file__).resolve().parents[1] / "clearsim" / "configs" / "uhv_breaker.yaml"
 MODE_NAMES = {0: "free", 1: "contact", 2: "stick", 3: "slide_back"}
 COORDINATE = ("x", "y", "θ")
 
 
-@njit
 def trial_error(system, dynamics, t, y, f, h, modes, speeds):
     """The error vector and y_new of one DOPRI5 try (the loop's own step)."""
     stages = np.empty((STAGES, y.shape[0]))
     y_new = np.empty_like(y)
     error = step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new)
     return error, y_new
+
+
+def whole_jacobian(system, dynamics, t, y, f, h, modes, speeds, skipped_from, skipped_count, floor, jacobian, record):
+    """rosenbrock's finite-difference Jacobian into jacobian (record: evaluate_jacobian's, which it reads and writes)."""
+    return evaluate_jacobian(system, dynamics, t, y, f, h, modes, speeds, skipped_from, skipped_count, floor, jacobian,
+                             record)
+
+
+def by_address(arrays, lubricated: bool):
+    """trial_error and whole_jacobian compiled for these kernel arrays with the dynamics taken by address, as the
+    integrator's loop takes it (integrator.addressed_kernels): the cached kernels they call (the right-hand side,
+    evaluate_jacobian) are then compiled for a function signature, found in the cache by the next process, and not
+    for this process's dispatcher object, whose type the cache index cannot store again once that object is gone."""
+    from clearsim.solver import integrator as ig
+
+    system_type = typeof(arrays)
+    dynamics = ig.addressed_kernels(system_type, ig.DOPRI5, lubricated)[2][1]
+    F, I, V, IV, M = types.float64, types.int64, types.float64[::1], types.int64[::1], types.float64[:, ::1]
+    trial = njit(types.Tuple((V, V))(system_type, dynamics, F, V, V, F, IV, V))(trial_error)
+    jacobian = njit(I(system_type, dynamics, F, V, V, F, IV, V, I, I, F, M, IV))(whole_jacobian)
+    return trial, jacobian
 
 
 def stability_function(z: complex) -> complex:
@@ -88,14 +109,16 @@ def component_name(system, index: int) -> str:
     return f"state[{index}]"
 
 
-def jacobian_stability(arrays, dynamics, t, y, f, h, tried, modes, speeds, n, floor) -> dict:
+def jacobian_stability(jacobian_of, arrays, dynamics, t, y, f, h, tried, modes, speeds, n, floor,
+                       no_jacobian_yet) -> dict:
     """The whole system's picture: eigenvalues of the finite-difference ∂f/∂y of q, q̇ (rosenbrock's), the largest
-    h·|λ| and max |R(hλ)| over them at the accepted and at the first-tried step."""
+    h·|λ| and max |R(hλ)| over them at the accepted and at the first-tried step. no_jacobian_yet: a new zeroed record
+    shaped as the run's jacobian_modes (the modes and the two counts after them, which evaluate_jacobian reads and
+    writes), so every column is taken; jacobian_of: whole_jacobian compiled by_address."""
     from clearsim.assembly.dynamics import WORK_COUNT
-    from clearsim.solver.rosenbrock import evaluate_jacobian
 
     jacobian = np.zeros((y.size, y.size + 1))
-    evaluate_jacobian(arrays, dynamics, t, y, f, h, modes, speeds, 2 * n, WORK_COUNT, floor, jacobian, modes.copy())
+    jacobian_of(arrays, dynamics, t, y, f, h, modes, speeds, 2 * n, WORK_COUNT, floor, jacobian, no_jacobian_yet)
     eigenvalues = np.linalg.eigvals(jacobian[:2 * n, :2 * n])
     fastest = eigenvalues[np.argmax(np.abs(eigenvalues))]
     return {"jac_h_lambda": float(h * abs(fastest)), "jac_fastest_real": float(fastest.real),
@@ -117,6 +140,7 @@ def trace(config: Path, overrides: list[str], jacobian_every: int = 0) -> tuple[
     arrays, dynamics = run.kernel_arrays, ig.addressed(ig.DOPRI5, run.lubricated)[2]
     n = system.coordinate_count
     rtol, atol = run.real[ig.R_RTOL], run.real[ig.R_ATOL]
+    trial, jacobian_of = by_address(arrays, run.lubricated)
     controlled = np.r_[np.arange(2 * n), np.arange(2 * n + WORK_COUNT, run.y.size - wear_state_count(arrays))]
     rows: list[dict] = []
     while True:
@@ -139,14 +163,15 @@ def trace(config: Path, overrides: list[str], jacobian_every: int = 0) -> tuple[
                "after_switch": bool(rows) and rows[-1]["switched"],
                "switched": int(run.ints[ig.I_EVENTS] + run.ints[ig.I_FRICTION_EVENTS]) > events
                or not np.array_equal(modes, run.modes)}
-        error, y_new = trial_error(arrays, dynamics, t, y, f, max(tried, run.real[ig.R_MIN_STEP]), modes, speeds)
+        error, y_new = trial(arrays, dynamics, t, y, f, max(tried, run.real[ig.R_MIN_STEP]), modes, speeds)
         scaled = (error / (atol + rtol * np.maximum(np.abs(y), np.abs(y_new))))[controlled]
         worst = int(np.argmax(np.abs(scaled)))
         row["limiting"] = component_name(system, int(controlled[worst]))
         row["limiting_share"] = float(scaled[worst] ** 2 / max(np.sum(scaled**2), 1e-300))
         row["first_norm"] = float(np.sqrt(np.sum(scaled**2) / (run.y.size - WORK_COUNT - wear_state_count(arrays))))
         if jacobian_every and len(rows) % jacobian_every == 0:
-            row.update(jacobian_stability(arrays, dynamics, t, y, f, row["h"], tried, modes, speeds, n, atol / rtol))
+            row.update(jacobian_stability(jacobian_of, arrays, dynamics, t, y, f, row["h"], tried, modes, speeds, n, atol / rtol,
+                                          np.zeros_like(run.jacobian_modes)))
         for k, name in enumerate(system.clearance_joints):
             row[f"sliding_{name}"] = clearance_kinematics(arrays, k, y[:n], y[n:2 * n])[8]
             row[f"sliding_end_{name}"] = clearance_kinematics(arrays, k, run.y[:n], run.y[n:2 * n])[8]

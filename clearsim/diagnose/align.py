@@ -465,14 +465,31 @@ DECAYED_LAGS = 10  # the residual's autocorrelation has decayed where it stays w
 
 
 @dataclass(frozen=True)
-class NoiseTest:
-    """Is a residual consistent with the noise? Per sensor, gap² = mean(r²)/σ̂² against F(n_eff, ν): the residual's
-    squares are worth n_eff independent ones (from its autocorrelation), σ̂² has ν degrees of freedom."""
+class ChaoticSpread:
+    """What the model's own realisations of a chaotic impact sequence add to a residual (docs/diagnose.md §5b): per
+    sensor, the variance D_k at each compared sample of a re-rolled twin's prediction about the reported one (the mean
+    over the twins of their squared differences, moving-averaged), and the degrees of freedom of that estimate."""
 
-    gaps: dict  # sensor → gap (RMS residual / σ̂)
-    effective_samples: dict  # sensor → n_eff of the residual
-    p_values: dict  # sensor → P(gap this large | noise alone)
+    variance: dict  # sensor → D_k over the compared samples (the sensor's unit squared)
+    degrees_of_freedom: dict  # sensor → ν_D
+    twins: int  # the twins it is estimated from
+
+    def in_noise_levels(self, record: Record) -> dict[str, float]:
+        """√(mean D_k)/σ̂ per sensor: how far, RMS, the twins stray from the reported run, in noise levels."""
+        return {s: float(np.sqrt(np.mean(d)) / record.noise[s].std) for s, d in self.variance.items()}
+
+
+@dataclass(frozen=True)
+class NoiseTest:
+    """Is a residual consistent with the noise (and the chaotic spread, when given)? Per sensor,
+    gap² = mean(r_k²/(σ̂² + D_k)) against F(n_eff, ν): the standardised residual's squares are worth n_eff independent
+    ones (from its autocorrelation), σ̂² + D̄ has ν degrees of freedom (Welch–Satterthwaite)."""
+
+    gaps: dict  # sensor → gap (RMS residual / σ̂; standardised by σ̂² + D_k where a spread is given)
+    effective_samples: dict  # sensor → n_eff of the (standardised) residual
+    p_values: dict  # sensor → P(gap this large | noise and spread alone)
     level: float = UNEXPLAINED_LEVEL
+    spread: dict = field(default_factory=dict)  # sensor → the twins' stray in noise levels (ChaoticSpread); {}: none
 
     @property
     def failing(self) -> list[str]:
@@ -503,13 +520,29 @@ def residual_effective_samples(residual: np.ndarray) -> float:
     return float(count / (1.0 + 2.0 * np.sum((1.0 - lags / count) * rho[1:last] ** 2)))
 
 
-def noise_test(record: Record, residual: dict[str, np.ndarray]) -> NoiseTest:
+def combined_degrees_of_freedom(noise_variance: float, noise_dof: float, spread_variance: float,
+                                spread_dof: float) -> float:
+    """ν of σ̂² + D̄ from those of its two terms (Welch–Satterthwaite): (σ̂² + D̄)² / (σ̂⁴/ν_σ + D̄²/ν_D)."""
+    if spread_variance <= 0.0:
+        return noise_dof
+    return float((noise_variance + spread_variance) ** 2
+                 / (noise_variance ** 2 / noise_dof + spread_variance ** 2 / spread_dof))
+
+
+def noise_test(record: Record, residual: dict[str, np.ndarray], spread: ChaoticSpread | None = None) -> NoiseTest:
     """The residual (in the comparison band, its compared samples) against the noise, per sensor:
-    p = P(F(n_eff, ν) ≥ gap²)."""
+    p = P(F(n_eff, ν) ≥ gap²); with a chaotic spread, each sample's residual against σ̂² + D_k (docs/diagnose.md D5)."""
     from scipy.stats import f as fisher
 
-    gaps = sensor_gaps(record, residual)
-    effective = {s: residual_effective_samples(r[record.compared]) for s, r in residual.items()}
-    p_values = {s: float(fisher.sf(gaps[s] ** 2, effective[s], min(record.noise[s].degrees_of_freedom, 1e9)))
-                for s in residual}
-    return NoiseTest(gaps, effective, p_values)
+    gaps, effective, p_values = {}, {}, {}
+    for s, r in residual.items():
+        noise = record.noise[s]
+        spread_variance = spread.variance[s] if spread is not None else np.zeros(1)
+        standardised = r[record.compared] / np.sqrt(noise.std ** 2 + spread_variance)
+        gaps[s] = float(np.sqrt(np.mean(standardised ** 2)))
+        effective[s] = residual_effective_samples(standardised)
+        dof = (combined_degrees_of_freedom(noise.std ** 2, noise.degrees_of_freedom, float(np.mean(spread_variance)),
+                                           spread.degrees_of_freedom[s]) if spread is not None
+               else noise.degrees_of_freedom)
+        p_values[s] = float(fisher.sf(gaps[s] ** 2, effective[s], min(dof, 1e9)))
+    return NoiseTest(gaps, effective, p_values, spread=spread.in_noise_levels(record) if spread is not None else {})

@@ -520,8 +520,8 @@ def candidates_for(mechanism, document: dict, kinds: list[str], base_dir: Path |
 PERTURBATION = 1e-9  # m: where each clearance joint's journal starts, off its given place: no bench controls it
 
 
-def perturbed(mechanism, document: dict, seed: int) -> dict:
-    """A copy of the document no bench could tell from it: each clearance joint's journal starts PERTURBATION off its
+def perturbed(mechanism, document: dict, seed: int, size: float = PERTURBATION) -> dict:
+    """A copy of the document no bench could tell from it: each clearance joint's journal starts `size` off its
     given place, in a direction drawn from numpy's generator seeded with `seed`. A rattling joint's impact sequence
     is chaotic, and this re-rolls it; without a clearance joint the copy is the document itself."""
     changed = copy.deepcopy(document)
@@ -529,6 +529,6 @@ def perturbed(mechanism, document: dict, seed: int) -> dict:
     for joint in _clearance_joints(mechanism):
         angle = rng.uniform(0.0, 2.0 * np.pi)
         x, y = joint.initial_eccentricity or (0.0, 0.0)
-        moved = (float(x + PERTURBATION * np.cos(angle)), float(y + PERTURBATION * np.sin(angle)))
+        moved = (float(x + size * np.cos(angle)), float(y + size * np.sin(angle)))
         _set(changed, f"joints.{joint.name}.initial_eccentricity", f"[{moved[0]!r} m, {moved[1]!r} m]")
     return changed

@@ -58,6 +58,7 @@ def _remaining(d: Diagnosis) -> dict:
     test = d.check.test
     return {"gap": d.after.gap, "gaps_settled": test.gaps, "effective_samples": test.effective_samples,
             "p_values": test.p_values, "level": test.level, "beyond_noise": test.failing,
+            "chaotic_spread": test.spread,
             "windows": [{"sensor": w.sensor, "start_s": w.start, "end_s": w.end, "peak_noise_levels": w.peak}
                         for w in d.check.windows],
             "helpful_sensors": d.check.helpful_sensors}
@@ -184,7 +185,8 @@ def unexplained_line(d: Diagnosis) -> str:
     windows = ", ".join(f"{w.sensor} {w.start * 1e3:.3g}–{w.end * 1e3:.3g} ms ({w.peak:.1f}σ̂)" for w in check.windows[:3])
     helpful = ", ".join(check.helpful_sensors) or "none among the model's sensors (add one near those windows)"
     model = "the model with the effects found" if d.effects else "the model"
-    return (f"unexplained: the record stays {d.after.gap:.3g} noise levels from {model}, beyond the noise on {failing} "
+    beyond = "the noise and the model's chaotic spread" if test.spread else "the noise"
+    return (f"unexplained: the record stays {d.after.gap:.3g} noise levels from {model}, beyond {beyond} on {failing} "
             f"(F test at {test.level:g}); it disagrees most at {windows or 'no 1-ms window above 3σ̂'}; "
             f"sensors that would tell more: {helpful}")
 
@@ -196,12 +198,22 @@ def _remaining_lines(d: Diagnosis) -> list[str]:
     out = [f"## What remains: {'unexplained' if d.check.unexplained else 'noise'}", "",
            f"F test of each sensor's residual against the noise at {test.level:g} (shared among the sensors): "
            "gap² against F(n_eff, ν), n_eff from the residual's autocorrelation, ν the degrees of freedom of σ̂ "
-           "(docs/diagnose.md §5).", "", "| sensor | gap | n_eff | p | beyond the noise |", "|---|---|---|---|---|"]
+           "(docs/diagnose.md §5b).", "", *_spread_lines(test),
+           "| sensor | gap | n_eff | p | beyond the noise |", "|---|---|---|---|---|"]
     out += [f"| {s} | {test.gaps[s]:.3g} | {test.effective_samples[s]:.0f} | {test.p_values[s]:.2g} | "
             f"{'yes' if s in test.failing else 'no'} |" for s in test.gaps]
     if d.check.unexplained:
         out += ["", unexplained_line(d) + "."]
     return out + [""]
+
+
+def _spread_lines(test) -> list[str]:
+    """The chaotic spread counted with the noise, when the test counted one."""
+    if not test.spread:
+        return []
+    strays = ", ".join(f"{s} {stray:.3g}" for s, stray in test.spread.items())
+    return [f"Each residual sample is set against σ̂² + the spread of the final model's re-rolled twins there (they "
+            f"stray {strays} noise levels, RMS): impacts the record replays otherwise are no model error.", ""]
 
 
 def _markdown(d: Diagnosis, figures: list[Path], model_path: Path) -> str:

@@ -50,11 +50,11 @@ from scipy.stats import chi2, norm
 from scipy.stats import f as fisher
 from scipy.stats import t as student
 
-from clearsim.diagnose.align import (INTERVAL_LEVEL, Fit, Record, chi_square_halves, fit_at, fit_offset, predict, residuals,
-                                    sensor_gaps)
+from clearsim.diagnose.align import (INTERVAL_LEVEL, ChaoticSpread, Fit, Record, chi_square_halves, fit_at, fit_offset,
+                                    predict, residual_effective_samples, residuals, sensor_gaps)
 from clearsim.diagnose.candidates import Candidate, with_effects
 from clearsim.diagnose.evaluate import Evaluator, Prediction
-from clearsim.diagnose.features import dominant_frequency
+from clearsim.diagnose.features import WINDOW_SECONDS, dominant_frequency
 
 SCREEN_POINTS = (0.3, 0.75)  # of the range (in log units for scale parameters)
 SCAN_POINTS = 6
@@ -235,6 +235,33 @@ def twin_gaps(record: Record, model: Prediction, twins: list[Prediction], offset
     own = aligned(model)
     strays = [sensor_gaps(record, {s: own[s] - m for s, m in aligned(twin).items()}) for twin in twins]
     return {s: max((stray[s] for stray in strays), default=0.0) for s in record.values}
+
+
+def chaotic_spread(record: Record, reported: Prediction, twins: list[Prediction], offset: float) -> ChaoticSpread | None:
+    """The variance the model's realisations add to the residual, per sensor and compared sample (docs/diagnose.md
+    §5b): D_k = the moving average over WINDOW_SECONDS of mean_j (m_twin,j − m)_k², both in the comparison band at the
+    reported run's trigger offset. A residual against one realisation when the record is another has the expectation
+    σ² + 2V_k, and so has (m_twin − m)²: D_k is added to σ̂² as it is. Its degrees of freedom ν_D = Σ_j n_eff of twin
+    j's difference (D6). Twins that failed are left out; None when none ran."""
+    ran = [twin for twin in twins if twin.ok]
+    if not ran:
+        return None
+
+    def aligned(prediction: Prediction) -> dict[str, np.ndarray]:
+        return predict(record, prediction.time, {s: prediction.sensors[s] for s in record.values}, offset)
+
+    own = aligned(reported)
+    differences = [{s: (m - own[s])[record.compared] for s, m in aligned(twin).items()} for twin in ran]
+    width = max(int(round(WINDOW_SECONDS * record.rate)), 1)
+    variance = {s: moving_mean(np.mean([d[s] ** 2 for d in differences], axis=0), width) for s in record.values}
+    dof = {s: float(sum(residual_effective_samples(d[s]) for d in differences)) for s in record.values}
+    return ChaoticSpread(variance, dof, len(ran))
+
+
+def moving_mean(values: np.ndarray, width: int) -> np.ndarray:
+    """The mean over the `width` samples centred on each one (fewer at the ends: the mean of those there)."""
+    kernel = np.ones(min(width, len(values)))
+    return np.convolve(values, kernel, mode="same") / np.convolve(np.ones_like(values), kernel, mode="same")
 
 
 AS_GIVEN = "the model as given"

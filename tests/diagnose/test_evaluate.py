@@ -41,7 +41,7 @@ def documents(*values):
 
 @pytest.fixture
 def evaluator(tmp_path: Path):
-    return Evaluator(tmp_path / "runs", "model.yaml", tmp_path, ReversedExecutor(), min_output_rate=100.0)
+    return Evaluator(tmp_path / "runs", "model.yaml", tmp_path, ReversedExecutor(), output_rate=100.0)
 
 
 def test_results_in_document_order_each_computed_when_its_run_ends(evaluator):

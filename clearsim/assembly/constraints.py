@@ -221,11 +221,16 @@ def schur_complement(system, blocks, bodies):
     for b in range(nb):
         for e in range(count[b], count[b + 1]):
             i, si = entries[e, 0], entries[e, 1]
+            # Φ_i M⁻¹ once per entry: the products below are (a·m)·b left to right, so the same bits
+            ax = blocks[i, si, 0] * minv[3 * b]
+            ay = blocks[i, si, 1] * minv[3 * b + 1]
+            aw = blocks[i, si, 2] * minv[3 * b + 2]
             for f in range(count[b], e + 1):
                 j, sj = entries[f, 0], entries[f, 1]
                 total = 0.0
-                for c in range(3):
-                    total += blocks[i, si, c] * minv[3 * b + c] * blocks[j, sj, c]
+                total += ax * blocks[j, sj, 0]
+                total += ay * blocks[j, sj, 1]
+                total += aw * blocks[j, sj, 2]
                 pi, pj = places[i], places[j]
                 schur[pi, pj] += total
                 if i != j:

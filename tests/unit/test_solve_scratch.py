@@ -8,6 +8,7 @@ from clearsim.assembly.arrays import for_kernels
 from clearsim.assembly.constraints import constraint_count, dense_jacobian, evaluate_acceleration_rhs
 from clearsim.assembly.dynamics import accelerations
 from clearsim.assembly.forces import CONTACT, STICK, clearance_kinematics
+from clearsim.assembly.kinematics import kept_frame
 from clearsim.model.loader import load_mechanism
 from clearsim.runner import BUNDLED_CONFIG, prepare
 from tests.unit.test_constraints import mixed_system
@@ -68,3 +69,6 @@ def test_kept_cosines_and_sines_are_used_only_for_their_own_angle():
             assert np.array_equal(got, want)
         got, want = _kinematics_of_both_joints(shared, q, qd), _kinematics_of_both_joints(for_kernels(system.arrays), q, qd)
         assert np.array_equal(np.signbit(got), np.signbit(want)) and np.array_equal(got, want)
+    for body in range(q_zero.size // 3):  # the sine of −0 after that of +0 was kept: −0
+        assert not np.signbit(kept_frame(shared, q_zero, body)[3])
+        assert np.signbit(kept_frame(shared, q_minus_zero, body)[3])

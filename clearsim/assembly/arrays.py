@@ -139,6 +139,7 @@ WORKSPACE_FIELDS = [
     "solve_placed",  # (rows,) a right-hand side in those places, while it is solved
     "factor_key",  # (1 + nc,) what solve_lower holds: none / positive definite / not; which joints have stick rows
     "factor_q",  # (3 nb,) the q it was computed at
+    "frame_trig",  # (nb, 3) θ, cos θ, sin θ of each body at the θ last seen (kinematics.kept_frame); θ NaN: none yet
 ]
 
 
@@ -168,7 +169,8 @@ def _workspace(arrays: SystemArrays) -> tuple:
             np.zeros((rows, rows)), np.zeros(rows, np.int64), np.arange(rows, dtype=np.int64), np.zeros(rows, np.int64),
             np.zeros(bodies + 1, np.int64),
             np.zeros((2 * rows, 2), np.int64), np.zeros(bodies, np.int64), np.zeros(3 * bodies), np.zeros(rows),
-            places, np.zeros(rows), np.zeros(1 + arrays.clearance_bodies.shape[0], np.int64), np.zeros(3 * bodies))
+            places, np.zeros(rows), np.zeros(1 + arrays.clearance_bodies.shape[0], np.int64), np.zeros(3 * bodies),
+            np.full((bodies, 3), np.nan))
 
 
 def for_kernels(arrays: SystemArrays) -> KernelArrays:

@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 from clearsim.assembly.arrays import OFF_DIRECTION, OFF_POINT_I, OFF_POINT_J, OFF_VALUE
-from clearsim.assembly.kinematics import body_frame, body_pose, body_rates, frame_point, frame_rotate, frame_velocity
+from clearsim.assembly.kinematics import body_pose, body_rates, frame_point, frame_rotate, frame_velocity, kept_frame
 from clearsim.physics.motion import evaluate_piecewise
 
 
@@ -52,14 +52,14 @@ def evaluate_constraints(system, t, q, phi):
     row = 0
     for k in range(system.pin_bodies.shape[0]):
         s = system.pin_points[k]
-        xi, yi = frame_point(body_frame(q, system.pin_bodies[k, 0]), s[0], s[1])
-        xj, yj = frame_point(body_frame(q, system.pin_bodies[k, 1]), s[2], s[3])
+        xi, yi = frame_point(kept_frame(system, q, system.pin_bodies[k, 0]), s[0], s[1])
+        xj, yj = frame_point(kept_frame(system, q, system.pin_bodies[k, 1]), s[2], s[3])
         phi[row] = xi - xj
         phi[row + 1] = yi - yj
         row += 2
     for k in range(system.offset_bodies.shape[0]):
-        frame_i = body_frame(q, system.offset_bodies[k, 0])
-        frame_j = body_frame(q, system.offset_bodies[k, 1])
+        frame_i = kept_frame(system, q, system.offset_bodies[k, 0])
+        frame_j = kept_frame(system, q, system.offset_bodies[k, 1])
         wx, wy, dx, dy = _offset_terms(frame_i, frame_j, system.offset_params[k])
         phi[row] = wx * dx + wy * dy - system.offset_params[k, OFF_VALUE] - prescribed(system, system.offset_law[k], t)[0]
         row += 1
@@ -81,7 +81,7 @@ def evaluate_jacobian_blocks(system, q, blocks, bodies):
     for k in range(system.pin_bodies.shape[0]):
         bi = system.pin_bodies[k, 0]
         bj = system.pin_bodies[k, 1]
-        aix, aiy, ajx, ajy = _arms(body_frame(q, bi), body_frame(q, bj), system.pin_points[k])
+        aix, aiy, ajx, ajy = _arms(kept_frame(system, q, bi), kept_frame(system, q, bj), system.pin_points[k])
         for axis in range(2):
             blocks[row + axis, 0, axis] = 1.0
             blocks[row + axis, 1, axis] = -1.0
@@ -94,8 +94,8 @@ def evaluate_jacobian_blocks(system, q, blocks, bodies):
     for k in range(system.offset_bodies.shape[0]):
         bi = system.offset_bodies[k, 0]
         bj = system.offset_bodies[k, 1]
-        frame_i = body_frame(q, bi)
-        frame_j = body_frame(q, bj)
+        frame_i = kept_frame(system, q, bi)
+        frame_j = kept_frame(system, q, bj)
         wx, wy, dx, dy = _offset_terms(frame_i, frame_j, system.offset_params[k])
         aix, aiy, ajx, ajy = _arms(frame_i, frame_j, system.offset_params[k])
         bodies[row, 0], bodies[row, 1] = bi, bj
@@ -221,11 +221,16 @@ def schur_complement(system, blocks, bodies):
     for b in range(nb):
         for e in range(count[b], count[b + 1]):
             i, si = entries[e, 0], entries[e, 1]
+            # Φ_i M⁻¹ once per entry: the products below are (a·m)·b left to right, so the same bits
+            ax = blocks[i, si, 0] * minv[3 * b]
+            ay = blocks[i, si, 1] * minv[3 * b + 1]
+            aw = blocks[i, si, 2] * minv[3 * b + 2]
             for f in range(count[b], e + 1):
                 j, sj = entries[f, 0], entries[f, 1]
                 total = 0.0
-                for c in range(3):
-                    total += blocks[i, si, c] * minv[3 * b + c] * blocks[j, sj, c]
+                total += ax * blocks[j, sj, 0]
+                total += ay * blocks[j, sj, 1]
+                total += aw * blocks[j, sj, 2]
                 pi, pj = places[i], places[j]
                 schur[pi, pj] += total
                 if i != j:
@@ -254,7 +259,7 @@ def evaluate_acceleration_rhs(system, t, q, qd, gamma):
         bj = system.pin_bodies[k, 1]
         wi = body_rates(qd, bi)[2]
         wj = body_rates(qd, bj)[2]
-        aix, aiy, ajx, ajy = _arms(body_frame(q, bi), body_frame(q, bj), system.pin_points[k])
+        aix, aiy, ajx, ajy = _arms(kept_frame(system, q, bi), kept_frame(system, q, bj), system.pin_points[k])
         gamma[row] = aix * wi * wi - ajx * wj * wj
         gamma[row + 1] = aiy * wi * wi - ajy * wj * wj
         row += 2
@@ -264,8 +269,8 @@ def evaluate_acceleration_rhs(system, t, q, qd, gamma):
         p = system.offset_params[k]
         wi = body_rates(qd, bi)[2]
         wj = body_rates(qd, bj)[2]
-        frame_i = body_frame(q, bi)
-        frame_j = body_frame(q, bj)
+        frame_i = kept_frame(system, q, bi)
+        frame_j = kept_frame(system, q, bj)
         wx, wy, dx, dy = _offset_terms(frame_i, frame_j, p)
         vix, viy = frame_velocity(frame_i, qd, bi, p[OFF_POINT_I], p[OFF_POINT_I + 1])
         vjx, vjy = frame_velocity(frame_j, qd, bj, p[OFF_POINT_J], p[OFF_POINT_J + 1])

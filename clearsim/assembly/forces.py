@@ -24,8 +24,8 @@ from clearsim.assembly.arrays import (
     WEAR_SLOT, WEAR_SLOT_HARMONICS, WEAR_WEIGHTS,
 )
 from clearsim.assembly.kinematics import (
-    GROUND, add_global_force, add_point_force, body_frame, body_pose, body_rates, frame_point, frame_rotate,
-    frame_velocity, line_kinematics, point_position, point_velocity,
+    GROUND, add_global_force, add_point_force, body_pose, body_rates, frame_point, frame_rotate, frame_velocity,
+    kept_frame, line_kinematics, point_position, point_velocity,
 )
 from clearsim.assembly.constraints import prescribed
 from clearsim.assembly.drivelines import driveline_potential
@@ -50,8 +50,8 @@ def clearance_kinematics(system, k, q, qd):
     p = system.clearance_params[k]
     bearing = system.clearance_bodies[k, 0]
     journal = system.clearance_bodies[k, 1]
-    bearing_frame = body_frame(q, bearing)
-    journal_frame = body_frame(q, journal)
+    bearing_frame = kept_frame(system, q, bearing)
+    journal_frame = kept_frame(system, q, journal)
     bx, by = frame_point(bearing_frame, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
     jx, jy = frame_point(journal_frame, p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
     bvx, bvy = frame_velocity(bearing_frame, qd, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
@@ -136,8 +136,8 @@ def stick_row(system, k, q, qd):
     journal = system.clearance_bodies[k, 1]
     ex, ey, dex, dey, _, rate, nx, ny, _ = clearance_kinematics(system, k, q, qd)
     tx, ty = -ny, nx
-    abx, aby = frame_rotate(body_frame(q, bearing), p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
-    ajx, ajy = frame_rotate(body_frame(q, journal), p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
+    abx, aby = frame_rotate(kept_frame(system, q, bearing), p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+    ajx, ajy = frame_rotate(kept_frame(system, q, journal), p[CL_JOURNAL_POINT], p[CL_JOURNAL_POINT + 1])
     wb = body_rates(qd, bearing)[2]
     wj = body_rates(qd, journal)[2]
     if system.wear_harmonics[k] > 0:
@@ -198,7 +198,7 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized, with_
         fy = -fn * ny + ft * nx
         bearing = system.clearance_bodies[k, 0]
         journal = system.clearance_bodies[k, 1]
-        bx, by = point_position(q, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+        bx, by = frame_point(kept_frame(system, q, bearing), p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
         add_global_force(generalized, q, journal, bx + ex + p[CL_JOURNAL_RADIUS] * nx,
                          by + ey + p[CL_JOURNAL_RADIUS] * ny, fx, fy)
         arm_x, arm_y = bearing_contact_arm(system, k, q, qd, kinematics)
@@ -293,7 +293,7 @@ def add_film_forces(system, k, q, qd, generalized):
     fy = fn * ny + ft * nx
     bearing = system.clearance_bodies[k, 0]
     journal = system.clearance_bodies[k, 1]
-    bx, by = point_position(q, bearing, p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+    bx, by = frame_point(kept_frame(system, q, bearing), p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
     add_global_force(generalized, q, journal, bx + ex, by + ey, fx, fy)
     add_global_force(generalized, q, bearing, bx + ex, by + ey, -fx, -fy)
     if journal != GROUND:

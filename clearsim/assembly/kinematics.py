@@ -40,6 +40,22 @@ def body_frame(q, body):
 
 
 @njit(cache=True)
+def kept_frame(system, q, body):
+    """body_frame with the body's cosine and sine kept in system.frame_trig (θ, cos θ, sin θ a body; arrays.py),
+    computed again only when θ changes bit for bit (and at every θ = 0, which compares equal to −0 but has its own sine):
+    Φ_q's blocks, γ and the clearance joints' kinematics at one q share them."""
+    if body == GROUND:
+        return 0.0, 0.0, 1.0, 0.0
+    angle = q[3 * body + 2]
+    trig = system.frame_trig
+    if trig[body, 0] != angle or angle == 0.0:
+        trig[body, 0] = angle
+        trig[body, 1] = np.cos(angle)
+        trig[body, 2] = np.sin(angle)
+    return q[3 * body], q[3 * body + 1], trig[body, 1], trig[body, 2]
+
+
+@njit(cache=True)
 def frame_rotate(frame, sx, sy):
     """A(θ) s."""
     c, s = frame[2], frame[3]

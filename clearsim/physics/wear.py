@@ -223,30 +223,20 @@ def evaluate_profile(coefficients, angles) -> np.ndarray:
     return depth
 
 
-def curvature_radii(coefficients, bearing_radius: float, angles) -> np.ndarray:
-    """The bore's radius of curvature (m) at each angle (bore_curvature_radius on an array; inf where the bore is
-    straight or bulges inwards)."""
-    coefficients = np.asarray(coefficients, float)
-    angles = np.asarray(angles, float)
-    rho = np.full(angles.shape, bearing_radius + coefficients[0])
-    slope, curvature = np.zeros(angles.shape), np.zeros(angles.shape)
-    for m in range(1, (coefficients.shape[0] - 1) // 2 + 1):
-        wave = coefficients[2 * m - 1] * np.cos(m * angles) + coefficients[2 * m] * np.sin(m * angles)
-        rho += wave
-        slope += m * (coefficients[2 * m] * np.cos(m * angles) - coefficients[2 * m - 1] * np.sin(m * angles))
-        curvature -= m * m * wave
-    bending = rho * rho + 2.0 * slope * slope - rho * curvature
-    with np.errstate(divide="ignore"):
-        return np.where(bending > 0.0, (rho * rho + slope * slope) ** 1.5 / np.where(bending > 0.0, bending, 1.0),
-                        np.inf)
-
-
 def tightest_radius(coefficients, bearing_radius: float) -> float:
     """The smallest radius of curvature (m) of the bore, on 64 M angles: a journal of a larger radius pressed into
     the bore there touches it at two points (the distance from its centre has two minima)."""
-    harmonics = max((len(coefficients) - 1) // 2, 1)
-    return float(curvature_radii(coefficients, bearing_radius,
-                                 np.linspace(0.0, 2.0 * math.pi, 64 * harmonics, endpoint=False)).min())
+    coefficients = np.asarray(coefficients, float)
+    harmonics = (coefficients.shape[0] - 1) // 2
+    return _smallest_curvature_radius(coefficients, harmonics, bearing_radius, 64 * max(harmonics, 1))
+
+
+@njit(cache=True)
+def _smallest_curvature_radius(coefficients, harmonics, bearing_radius, angles):
+    smallest = math.inf
+    for i in range(angles):
+        smallest = min(smallest, bore_curvature_radius(coefficients, harmonics, bearing_radius, 2.0 * math.pi * i / angles))
+    return smallest
 
 
 def profile_coefficients(cos: list[float], sin: list[float]) -> np.ndarray:

@@ -258,14 +258,14 @@ WEAR_DEPTH_BOUNDS = (2e-6, 0.5e-3)  # m: peak depth d of a worn arc, 2 µm to 0.
 WEAR_ANGLE_STEP = math.radians(30.0)  # positions φ of the worn arc tried: every 30° of the bore
 WEAR_ARC = math.radians(60.0)  # the worn arc's width w = R_B · 60° (the Archard kernel's, physics/wear.py)
 WEAR_HARMONICS = 16  # harmonics of the worn arc's profile: its kernel's σ = 0.42 rad is above the ringing limit 4/16
-WEAR_POCKET_CLEARANCE = 0.5  # the worn arc's tightest curvature radius leaves the journal ≥ this share of the clearance
+WEAR_POCKET_CLEARANCE = 0.1  # the worn arc's tightest curvature radius leaves the journal this share of the clearance
 
 
 def worn_arc(depth: float, angle: float, radius: float, clearance: float) -> np.ndarray:
     """[a_0, a_1, b_1, …] (m) of a worn arc of peak depth d at φ in a bore of radius R_B and radial clearance c:
     h(θ) = d K(θ − φ)/K(0), K the Archard wear kernel of width R_B · WEAR_ARC — the shape Archard wear leaves under a
     contact that stays at φ (its mean a_0 = d w/2π is the uniform clearance the worn volume adds) — or wider, as a
-    journal wears it: the pocket's tightest radius of curvature is at least R_J + c/2 (arc_sigma)."""
+    journal wears it: the pocket's tightest radius of curvature is at least R_J + c/10 (arc_sigma)."""
     return _kernel_arc(depth, angle, arc_sigma(depth, radius, clearance))
 
 
@@ -274,7 +274,7 @@ def arc_sigma(depth: float, radius: float, clearance: float) -> float:
     radius of curvature is R_B − (1 − WEAR_POCKET_CLEARANCE) c, when the 60° arc is tighter than that. A journal
     cannot wear a pocket tighter than itself, and one tighter than the journal touches it at two points, between
     which the one-point contact's normal flips (a 0.0105 mm arc in a 0.01 mm joint of R_B = 50 mm: radius 49.950 mm
-    against the journal's 49.990 mm)."""
+    against the journal's 49.990 mm; 49.991 mm as widened)."""
     narrow = kernel_sigma(WEAR_ARC * radius, WEAR_HARMONICS, radius)
     loosest = radius - (1.0 - WEAR_POCKET_CLEARANCE) * clearance
 

@@ -23,6 +23,7 @@ from clearsim.model.resolve import is_clearance_joint, resolve_clearance
 from clearsim.model.schema import Mechanism, StrokeMotion
 from clearsim.physics.wear import (
     add_kernel_rates, evaluate_profile, kernel_sigma, kernel_weights, profile_block, summed_coefficients,
+    tightest_radius,
 )
 from clearsim.units import DIMENSIONS, si_text, to_si
 
@@ -257,13 +258,42 @@ WEAR_DEPTH_BOUNDS = (2e-6, 0.5e-3)  # m: peak depth d of a worn arc, 2 µm to 0.
 WEAR_ANGLE_STEP = math.radians(30.0)  # positions φ of the worn arc tried: every 30° of the bore
 WEAR_ARC = math.radians(60.0)  # the worn arc's width w = R_B · 60° (the Archard kernel's, physics/wear.py)
 WEAR_HARMONICS = 16  # harmonics of the worn arc's profile: its kernel's σ = 0.42 rad is above the ringing limit 4/16
+WEAR_POCKET_CLEARANCE = 0.1  # the worn arc's tightest curvature radius leaves the journal this share of the clearance
 
 
-def worn_arc(depth: float, angle: float, radius: float) -> np.ndarray:
-    """[a_0, a_1, b_1, …] (m) of a worn arc of peak depth d at φ in a bore of radius R_B: h(θ) = d K(θ − φ)/K(0), K
-    the Archard wear kernel of width R_B · WEAR_ARC — the shape Archard wear leaves under a contact that stays at φ
-    (its mean a_0 = d · WEAR_ARC/2π is the uniform clearance the worn volume adds)."""
-    weights = kernel_weights(kernel_sigma(WEAR_ARC * radius, WEAR_HARMONICS, radius), WEAR_HARMONICS)
+def worn_arc(depth: float, angle: float, radius: float, clearance: float) -> np.ndarray:
+    """[a_0, a_1, b_1, …] (m) of a worn arc of peak depth d at φ in a bore of radius R_B and radial clearance c:
+    h(θ) = d K(θ − φ)/K(0), K the Archard wear kernel of width R_B · WEAR_ARC — the shape Archard wear leaves under a
+    contact that stays at φ (its mean a_0 = d w/2π is the uniform clearance the worn volume adds) — or wider, as a
+    journal wears it: the pocket's tightest radius of curvature is at least R_J + c/10 (arc_sigma)."""
+    return _kernel_arc(depth, angle, arc_sigma(depth, radius, clearance))
+
+
+def arc_sigma(depth: float, radius: float, clearance: float) -> float:
+    """σ (rad) of a worn arc's kernel: that of the width R_B · WEAR_ARC, or the narrowest whose pocket's tightest
+    radius of curvature is R_B − (1 − WEAR_POCKET_CLEARANCE) c, when the 60° arc is tighter than that. A journal
+    cannot wear a pocket tighter than itself, and one tighter than the journal touches it at two points, between
+    which the one-point contact's normal flips (a 0.0105 mm arc in a 0.01 mm joint of R_B = 50 mm: radius 49.950 mm
+    against the journal's 49.990 mm; 49.991 mm as widened)."""
+    narrow = kernel_sigma(WEAR_ARC * radius, WEAR_HARMONICS, radius)
+    loosest = radius - (1.0 - WEAR_POCKET_CLEARANCE) * clearance
+
+    def slack(sigma: float) -> float:
+        return tightest_radius(_kernel_arc(depth, 0.0, sigma), radius) - loosest
+
+    if slack(narrow) >= 0.0:
+        return narrow
+    wide = 2.0 * narrow
+    while slack(wide) < 0.0:
+        wide *= 2.0
+    from scipy.optimize import brentq  # here: importing scipy.optimize takes 36 MB, in every sweep worker
+
+    return brentq(slack, narrow, wide, xtol=1e-6)
+
+
+def _kernel_arc(depth: float, angle: float, sigma: float) -> np.ndarray:
+    """[a_0, a_1, b_1, …] of d K(θ − φ)/K(0), K the wear kernel of σ on WEAR_HARMONICS."""
+    weights = kernel_weights(sigma, WEAR_HARMONICS)
     peak = (2.0 * weights.sum() - 1.0) / (2.0 * math.pi)
     coefficients = np.zeros(1 + 2 * WEAR_HARMONICS)
     add_kernel_rates(coefficients, weights, WEAR_HARMONICS, depth / peak, angle)
@@ -300,7 +330,8 @@ def wear_between(mechanism, candidate: Candidate) -> list[Candidate]:
 
 def _worn_arcs(mechanism, joint, angles) -> list[Candidate]:
     """A worn arc at each angle of a clearance joint's bore (none when its wall leaves no room for one)."""
-    radius = resolve_clearance(joint, mechanism.defaults).bearing_radius
+    parameters = resolve_clearance(joint, mechanism.defaults)
+    radius, clearance = parameters.bearing_radius, parameters.clearance
     worn = joint.wear.profile.coefficients() if joint.wear is not None and joint.wear.profile is not None else np.zeros(1)
     deepest = float(evaluate_profile(worn, np.linspace(0.0, 2.0 * math.pi, 360, endpoint=False)).max())
     wall = joint.wear.wall if joint.wear is not None else None
@@ -312,7 +343,7 @@ def _worn_arcs(mechanism, joint, angles) -> list[Candidate]:
         angle = float(angle) % (2.0 * math.pi)
 
         def write(doc, value, name=joint.name, angle=angle):
-            _set_profile(doc, name, summed_coefficients(worn, worn_arc(value, angle, radius)))
+            _set_profile(doc, name, summed_coefficients(worn, worn_arc(value, angle, radius, clearance)))
 
         out.append(Candidate("wear", joint.name, "depth", "m", WEAR_DEPTH_BOUNDS[0], high, True, None, write,
                              ("mm", 1e-3), angle=angle, parameters=2))

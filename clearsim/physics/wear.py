@@ -223,6 +223,22 @@ def evaluate_profile(coefficients, angles) -> np.ndarray:
     return depth
 
 
+def tightest_radius(coefficients, bearing_radius: float) -> float:
+    """The smallest radius of curvature (m) of the bore, on 64 M angles: a journal of a larger radius pressed into
+    the bore there touches it at two points (the distance from its centre has two minima)."""
+    coefficients = np.asarray(coefficients, float)
+    harmonics = (coefficients.shape[0] - 1) // 2
+    return _smallest_curvature_radius(coefficients, harmonics, bearing_radius, 64 * max(harmonics, 1))
+
+
+@njit(cache=True)
+def _smallest_curvature_radius(coefficients, harmonics, bearing_radius, angles):
+    smallest = math.inf
+    for i in range(angles):
+        smallest = min(smallest, bore_curvature_radius(coefficients, harmonics, bearing_radius, 2.0 * math.pi * i / angles))
+    return smallest
+
+
 def profile_coefficients(cos: list[float], sin: list[float]) -> np.ndarray:
     """[a_0, a_1, b_1, ...] from the YAML's `cos: [a_0, a_1, ...]` and `sin: [b_1, ...]` (missing terms 0)."""
     harmonics = max(len(cos) - 1, len(sin), 0)

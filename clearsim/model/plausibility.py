@@ -80,7 +80,27 @@ def _clearance_joint_warnings(mechanism, sizes: dict[str, float]) -> list[Proble
         warnings += _clearance_ratio(parameters, path + (("clearance",) if joint.clearance is not None
                                                          else ("journal_radius",)))
         warnings += _contact_stiffness(joint, mechanism.defaults, parameters, path)
+        warnings += _worn_pocket(joint, parameters, path)
     return warnings
+
+
+def _worn_pocket(joint, parameters, path: tuple) -> list[Problem]:
+    """A worn profile with a pocket tighter than the journal (its smallest radius of curvature below R_J): the journal
+    touches it at two points, between which the one-point contact's normal flips, and the run crawls."""
+    profile = joint.wear.profile if joint.wear is not None else None
+    if profile is None:
+        return []
+    from clearsim.physics.wear import tightest_radius
+
+    tightest = tightest_radius(profile.coefficients(), parameters.bearing_radius)
+    if tightest >= parameters.journal_radius:
+        return []
+    return [Problem(path + ("wear", "profile"), f"the worn bore of joint '{joint.name}' has a pocket tighter than its "
+                    f"journal (smallest radius of curvature {_length(tightest)} against the journal's "
+                    f"{_length(parameters.journal_radius)}): the journal touches it at two points and the contact "
+                    "flips between them, which makes the run take tiny steps",
+                    "check the profile's units and harmonics: a journal wears a pocket at least as wide as itself "
+                    "(fewer or smaller high harmonics widen it)")]
 
 
 def _bearing_size(joint, parameters, sizes, path: tuple) -> list[Problem]:

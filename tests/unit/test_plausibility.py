@@ -82,6 +82,22 @@ def test_stiffness_modulus_and_clearance_far_outside_the_physical_range(old, new
     assert expected in warnings_of(edited((old, new)))
 
 
+@pytest.mark.parametrize("harmonics, expected", [
+    # at the deepest point ρ = R_B + 2a = 10.04 mm, radius of curvature ρ²/(ρ + m² a) for a cos mθ
+    ("0.02 mm, 0, 0.02 mm", ""),  # an oval pocket (m = 2): 9.96 mm
+    ("0.02 mm, 0, 0, 0, 0, 0, 0, 0, 0.02 mm", "the worn bore of joint 'slider_pin' has a pocket tighter than its journal "
+                                               "(smallest radius of curvature 8.9 mm"),  # m = 8
+], ids=["wider than the journal", "tighter than the journal"])
+def test_a_worn_pocket_tighter_than_the_journal(harmonics, expected):
+    """The slider pin's journal is 9.5 mm in a 10 mm bore: a pocket whose radius of curvature falls below 9.5 mm
+    touches it at two points (the contact's normal then flips between them and the run crawls)."""
+    text = warnings_of(edited(("journal_radius: 9.5 mm ", f"wear: {{profile: {{cos: [{harmonics}]}}}}\n    journal_radius: 9.5 mm ")))
+    if expected:
+        assert "joints[2] 'slider_pin' → wear → profile" in text and expected in text
+    else:
+        assert text == ""
+
+
 def test_validate_prints_the_warnings_and_still_succeeds(tmp_path):
     config = tmp_path / "sc.yaml"
     config.write_text(edited(*LONG_CRANK, ("speed: 5000 rpm", "speed: 300")))

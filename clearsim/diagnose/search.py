@@ -227,13 +227,11 @@ def twin_gaps(record: Record, model: Prediction, twins: list[Prediction], offset
     compared samples and both at the model's trigger offset, in noise levels σ̂_s (D1's gap, with a twin in the
     record's place; a twin that fails counts as infinitely far). Above 1 the sensor is impact-rich: one run's
     sample-wise cost there is one realisation of a chaotic impact sequence."""
-    def aligned(prediction: Prediction) -> dict[str, np.ndarray]:
-        return predict(record, prediction.time, {s: prediction.sensors[s] for s in record.values}, offset)
-
     if not all(twin.ok for twin in twins):
         return {s: np.inf for s in record.values}
-    own = aligned(model)
-    strays = [sensor_gaps(record, {s: own[s] - m for s, m in aligned(twin).items()}) for twin in twins]
+    own = aligned_prediction(record, model, offset)
+    strays = [sensor_gaps(record, {s: own[s] - m for s, m in aligned_prediction(record, twin, offset).items()})
+              for twin in twins]
     return {s: max((stray[s] for stray in strays), default=0.0) for s in record.values}
 
 
@@ -247,11 +245,9 @@ def chaotic_spread(record: Record, reported: Prediction, twins: list[Prediction]
     if not ran:
         return None
 
-    def aligned(prediction: Prediction) -> dict[str, np.ndarray]:
-        return predict(record, prediction.time, {s: prediction.sensors[s] for s in record.values}, offset)
-
-    own = aligned(reported)
-    differences = [{s: (m - own[s])[record.compared] for s, m in aligned(twin).items()} for twin in ran]
+    own = aligned_prediction(record, reported, offset)
+    differences = [{s: (m - own[s])[record.compared] for s, m in aligned_prediction(record, twin, offset).items()}
+                   for twin in ran]
     width = max(int(round(WINDOW_SECONDS * record.rate)), 1)
     variance = {s: moving_mean(np.mean([d[s] ** 2 for d in differences], axis=0), width) for s in record.values}
     dof = {s: float(sum(residual_effective_samples(d[s]) for d in differences)) for s in record.values}
@@ -291,9 +287,15 @@ def score_point(record: Record, sensors: list[str], value: float, prediction: Pr
     return Point(value, fit, prediction, low_band=low_band)
 
 
+def aligned_prediction(record: Record, prediction: Prediction, offset: float) -> dict[str, np.ndarray]:
+    """The prediction of the record's sensors at trigger offset `offset`, on the record's samples in the comparison
+    band (D0)."""
+    return predict(record, prediction.time, {s: prediction.sensors[s] for s in record.values}, offset)
+
+
 def aligned_residuals(record: Record, prediction: Prediction, offset: float) -> dict[str, np.ndarray]:
     """The record minus the prediction at trigger offset `offset`, both in the comparison band (D0)."""
-    return residuals(record, predict(record, prediction.time, {s: prediction.sensors[s] for s in record.values}, offset))
+    return residuals(record, aligned_prediction(record, prediction, offset))
 
 
 def screen(evaluator, record, sensors, candidates: list[Candidate], document,

@@ -155,7 +155,8 @@ def strain_energies(system, link: str, shapes: np.ndarray) -> np.ndarray:
 
 def linearised_link_modes(mechanism, links: list[str], base_dir) -> dict[str, list[float]]:
     """Each flexible link's modes of the linearised model (Hz, ascending): the modes whose strain energy its springs
-    hold the largest share of, among `links` (module docstring)."""
+    hold the largest share of, among `links` (module docstring); a link that holds the largest share of none, the
+    coupled mode in which its share is largest (also its owner's)."""
     from clearsim.assembly.system import assemble
 
     system = assemble(_closed_clearances(mechanism), base_dir)
@@ -164,7 +165,13 @@ def linearised_link_modes(mechanism, links: list[str], base_dir) -> dict[str, li
     shares = np.array([strain_energies(system, link, shapes) / np.maximum(total, np.finfo(float).tiny)
                        for link in links]).reshape(len(links), -1)
     owner = np.argmax(shares, axis=0)
-    return {link: sorted(float(f) for f in frequencies[owner == k]) for k, link in enumerate(links)}
+    return {link: sorted(float(f) for f in frequencies[owner == k]) or _coupled_mode(frequencies, shares[k])
+            for k, link in enumerate(links)}
+
+
+def _coupled_mode(frequencies: np.ndarray, shares: np.ndarray) -> list[float]:
+    """[the mode in which a link's springs hold their largest share of the strain energy], or [] without modes."""
+    return [float(frequencies[np.argmax(shares)])] if shares.size and shares.max() > 0.0 else []
 
 
 def linearised_mode_frequencies(mechanism, links: list[str], base_dir) -> dict[str, float]:

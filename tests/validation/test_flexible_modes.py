@@ -5,12 +5,14 @@ summary line and `flexible_modes` attribute, there for a flexible model only."""
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 from typer.testing import CliRunner
 
+import clearsim
 from clearsim.cli import app
 from clearsim.io.hdf5 import read_result
 from clearsim.model.loader import load_mechanism_text
@@ -24,6 +26,7 @@ from tests.validation.test_flexible_beam import BENDING, LENGTH, MASS_PER_LENGTH
 # two links in series along x, O–A and A–B, pinned to ground at O, a mass M pinned at B; no gravity. With the second
 # link held rigid the first one's slide carries its own far half, the whole second link and M: m_eff = m₁/2 + m₂ + M;
 # the second one's, with the first held, its far half and M: m_eff = m₂/2 + M.
+CONFIGS = Path(clearsim.__file__).parent / "configs"
 K1, K2, M1, M2, TIP_MASS = 4e5, 9e5, 0.3, 0.5, 2.0
 TWO_LINKS = f"""
 name: two axial flexible links in series
@@ -111,6 +114,19 @@ def test_a_simply_supported_beam_links_modes_match_euler_bernoulli_and_converge(
     errors = np.array([supported_beam_errors(n) for n in (5, 10, 20)])
     assert np.all(np.abs(errors[1]) <= 1e-3)
     assert np.all(np.abs(errors[1:]) * 8 < np.abs(errors[:-1]))
+
+
+def test_a_link_that_owns_no_mode_of_the_linearised_model_gets_the_coupled_mode_it_holds_most_of():
+    """The flexible breaker with its arms cut into 10 segments: the lower linking board's axial spring holds 40 % of
+    the strain energy of the 2.33 kHz mode and the lower turn arm's bending springs 58 %, so the board owns no mode;
+    it is given that coupled mode (also the arm's), not none."""
+    path = CONFIGS / "uhv_breaker_flexible.yaml"
+    loaded = load_mechanism_text(path.read_text().replace("segments: 3", "segments: 10"), base_dir=CONFIGS)
+    links = flexible_link_names(loaded.document, "axial") + flexible_link_names(loaded.document, "beam")
+    modes = linearised_link_modes(loaded.mechanism, links, loaded.base_dir)
+    assert all(len(modes[link]) >= 1 and math.isfinite(modes[link][0]) for link in links)
+    board = modes["lower_linking_board"]
+    assert len(board) == 1 and board[0] in modes["lower_turn_arm"] and 2000.0 < board[0] < 2700.0
 
 
 def test_the_modes_listed_are_the_lowest_few_up_to_the_contacts_band():

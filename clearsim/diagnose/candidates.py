@@ -259,32 +259,38 @@ WEAR_ANGLE_STEP = math.radians(30.0)  # positions φ of the worn arc tried: ever
 WEAR_ARC = math.radians(60.0)  # the worn arc's width w = R_B · 60° (the Archard kernel's, physics/wear.py)
 WEAR_HARMONICS = 16  # harmonics of the worn arc's profile: its kernel's σ = 0.42 rad is above the ringing limit 4/16
 WEAR_POCKET_CLEARANCE = 0.1  # the worn arc's tightest curvature radius leaves the journal this share of the clearance
+NO_WEAR = np.zeros(1)  # the profile of an unworn bore, [a_0]
+UNIFORM_SIGMA = 4.0 * math.pi  # rad: a worn arc's kernel this wide is a uniform depth (its harmonics e^(−m² σ²/2) ≤ 5e-35)
 
 
-def worn_arc(depth: float, angle: float, radius: float, clearance: float) -> np.ndarray:
+def worn_arc(depth: float, angle: float, radius: float, clearance: float, present: np.ndarray = NO_WEAR) -> np.ndarray:
     """[a_0, a_1, b_1, …] (m) of a worn arc of peak depth d at φ in a bore of radius R_B and radial clearance c:
     h(θ) = d K(θ − φ)/K(0), K the Archard wear kernel of width R_B · WEAR_ARC — the shape Archard wear leaves under a
     contact that stays at φ (its mean a_0 = d w/2π is the uniform clearance the worn volume adds) — or wider, as a
-    journal wears it: the pocket's tightest radius of curvature is at least R_J + c/10 (arc_sigma)."""
-    return _kernel_arc(depth, angle, arc_sigma(depth, radius, clearance))
+    journal wears it: the pocket it makes with the bore's `present` wear has its tightest radius of curvature at
+    least R_J + c/10 (arc_sigma)."""
+    return _kernel_arc(depth, angle, arc_sigma(depth, radius, clearance, present, angle))
 
 
-def arc_sigma(depth: float, radius: float, clearance: float) -> float:
-    """σ (rad) of a worn arc's kernel: that of the width R_B · WEAR_ARC, or the narrowest whose pocket's tightest
-    radius of curvature is R_B − (1 − WEAR_POCKET_CLEARANCE) c, when the 60° arc is tighter than that. A journal
-    cannot wear a pocket tighter than itself, and one tighter than the journal touches it at two points, between
-    which the one-point contact's normal flips (a 0.0105 mm arc in a 0.01 mm joint of R_B = 50 mm: radius 49.950 mm
-    against the journal's 49.990 mm; 49.991 mm as widened)."""
+def arc_sigma(depth: float, radius: float, clearance: float, present: np.ndarray = NO_WEAR, angle: float = 0.0) -> float:
+    """σ (rad) of a worn arc's kernel at φ: that of the width R_B · WEAR_ARC, or the narrowest whose sum with the
+    bore's `present` wear has its tightest radius of curvature at R_B − (1 − WEAR_POCKET_CLEARANCE) c, when the 60°
+    arc makes it tighter than that. A journal cannot wear a pocket tighter than itself, and one tighter than the
+    journal touches it at two points, between which the one-point contact's normal flips (a 0.0105 mm arc in a
+    0.01 mm joint of R_B = 50 mm: radius 49.950 mm against the journal's 49.990 mm; 49.991 mm as widened). A present
+    wear too tight for any arc to leave the journal that (`validate` warns of it) leaves the arc at its width."""
     narrow = kernel_sigma(WEAR_ARC * radius, WEAR_HARMONICS, radius)
     loosest = radius - (1.0 - WEAR_POCKET_CLEARANCE) * clearance
 
     def slack(sigma: float) -> float:
-        return tightest_radius(_kernel_arc(depth, 0.0, sigma), radius) - loosest
+        return tightest_radius(summed_coefficients(present, _kernel_arc(depth, angle, sigma)), radius) - loosest
 
     if slack(narrow) >= 0.0:
         return narrow
     wide = 2.0 * narrow
-    while slack(wide) < 0.0:
+    while slack(wide) < 0.0:  # a wide arc tends to a uniform depth d, which loosens every curvature by d
+        if wide > UNIFORM_SIGMA:
+            return narrow
         wide *= 2.0
     from scipy.optimize import brentq  # here: importing scipy.optimize takes 36 MB, in every sweep worker
 
@@ -332,7 +338,7 @@ def _worn_arcs(mechanism, joint, angles) -> list[Candidate]:
     """A worn arc at each angle of a clearance joint's bore (none when its wall leaves no room for one)."""
     parameters = resolve_clearance(joint, mechanism.defaults)
     radius, clearance = parameters.bearing_radius, parameters.clearance
-    worn = joint.wear.profile.coefficients() if joint.wear is not None and joint.wear.profile is not None else np.zeros(1)
+    worn = joint.wear.profile.coefficients() if joint.wear is not None and joint.wear.profile is not None else NO_WEAR
     deepest = float(evaluate_profile(worn, np.linspace(0.0, 2.0 * math.pi, 360, endpoint=False)).max())
     wall = joint.wear.wall if joint.wear is not None else None
     high = min(WEAR_DEPTH_BOUNDS[1], wall - deepest) if wall is not None else WEAR_DEPTH_BOUNDS[1]
@@ -343,7 +349,7 @@ def _worn_arcs(mechanism, joint, angles) -> list[Candidate]:
         angle = float(angle) % (2.0 * math.pi)
 
         def write(doc, value, name=joint.name, angle=angle):
-            _set_profile(doc, name, summed_coefficients(worn, worn_arc(value, angle, radius, clearance)))
+            _set_profile(doc, name, summed_coefficients(worn, worn_arc(value, angle, radius, clearance, worn)))
 
         out.append(Candidate("wear", joint.name, "depth", "m", WEAR_DEPTH_BOUNDS[0], high, True, None, write,
                              ("mm", 1e-3), angle=angle, parameters=2))

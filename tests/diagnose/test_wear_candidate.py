@@ -18,7 +18,7 @@ from clearsim.cli import app
 from clearsim.diagnose.candidates import WEAR_ARC, WEAR_DEPTH_BOUNDS, candidates_for, worn_arc
 from clearsim.diagnose.evaluate import document_text
 from clearsim.model.loader import load_mechanism, load_mechanism_text
-from clearsim.physics.wear import evaluate_profile, tightest_radius
+from clearsim.physics.wear import evaluate_profile, summed_coefficients, tightest_radius
 from clearsim.runner import simulate_config
 
 CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
@@ -116,6 +116,17 @@ def test_a_worn_arc_in_a_tight_joint_is_no_tighter_than_its_journal(depth):
     profile = evaluate_profile(arc, ANGLES)
     assert profile.max() == pytest.approx(depth, rel=1e-9)
     assert math.degrees(ANGLES[np.argmax(profile)]) == pytest.approx(120.0, abs=0.1)
+
+
+def test_a_worn_arc_added_to_a_present_wear_leaves_their_sum_no_tighter_than_the_journal():
+    """Joint A's bore already worn 0.0105 mm at 120° (an arc as the candidate writes it, as loose as allowed): a
+    second arc of that depth there, checked alone, is as loose as allowed too, but their sum is a pocket of 49.981 mm
+    against the 49.990 mm journal; the arc is widened until the sum leaves it a tenth of the clearance."""
+    radius, clearance, angle, depth = 0.05, 1e-5, math.radians(120.0), 1.05e-5
+    present = worn_arc(depth, angle, radius, clearance)
+    arc = worn_arc(depth, angle, radius, clearance, present)
+    assert tightest_radius(summed_coefficients(present, arc), radius) >= radius - 0.9 * clearance - 1e-3 * clearance
+    assert evaluate_profile(arc, ANGLES).max() == pytest.approx(depth, rel=1e-9)
 
 
 def test_a_worn_arc_in_a_tight_joint_takes_the_steps_of_the_unworn_joint(tmp_path):

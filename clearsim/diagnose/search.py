@@ -360,7 +360,7 @@ def to_fit(screened: list[Scored], baseline: Point, record: Record, count: int) 
     by_screening = sorted(screened, key=lambda s: s.best.chi_square)
     chosen = distinct(by_screening)[:count]
     lowering = [s for s in screened if low_band_best(s) < baseline.low_band_chi_square - VISIBLE]
-    chosen += distinct(sorted(lowering, key=low_band_best), chosen)[:count]
+    chosen += distinct(distinct(sorted(lowering, key=low_band_best))[:count], chosen)
     excess = max(baseline.chi_square - record.effective_samples, 0.0)
 
     def sensitivity(s: Scored) -> float:

@@ -9,7 +9,8 @@ around its best point, never a gradient method:
              ringing frequency matches the record's residual peak (f ∝ √k): its cost is a narrow well
              (a few % wide) that no grid finds
     scan     six more values over the range for the most promising candidates (chosen by χ² in the
-             comparison band and in the screening band, Record.low_band: frequency continuation)
+             comparison band and in the screening band, Record.low_band: frequency continuation; one per effect,
+             the worn arcs of a joint being one)
     valley   three values about the minimum of the profile in the screening band, where a clearance's
              cost is a smooth valley (in the comparison band it can be narrower than a scan step), and the
              midpoints between its lowest run there and that run's neighbours (the valley is within one step of

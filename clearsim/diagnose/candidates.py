@@ -53,6 +53,12 @@ class Candidate:
         return self.kind, self.target, self.parameter + (f" {self.around}" if self.angle is not None else "")
 
     @property
+    def quantity(self) -> tuple[str, str | None, str]:
+        """What the candidate changes, wherever it sits: the worn arcs of one joint at every angle are one quantity (a
+        depth at an angle), of which the search fits one member at a time (search.to_fit, search.candidate_pairs)."""
+        return self.kind, self.target, self.parameter
+
+    @property
     def around(self) -> str:
         return f"around {math.degrees(self.angle) % 360.0:.0f}°"
 

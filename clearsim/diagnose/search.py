@@ -9,7 +9,8 @@ around its best point, never a gradient method:
              ringing frequency matches the record's residual peak (f ∝ √k): its cost is a narrow well
              (a few % wide) that no grid finds
     scan     six more values over the range for the most promising candidates (chosen by χ² in the
-             comparison band and in the screening band, Record.low_band: frequency continuation)
+             comparison band and in the screening band, Record.low_band: frequency continuation; one per effect,
+             the worn arcs of a joint being one)
     valley   three values about the minimum of the profile in the screening band, where a clearance's
              cost is a smooth valley (in the comparison band it can be narrower than a scan step), and the
              midpoints between its lowest run there and that run's neighbours (the valley is within one step of
@@ -354,20 +355,34 @@ def to_fit(screened: list[Scored], baseline: Point, record: Record, count: int) 
     miss in the comparison band), and one more chosen by its sensitivity (the largest |Δχ²| of its
     screening runs): the one whose sensitivity is nearest above what is left to explain (χ² − n_eff), else
     the most sensitive. A candidate whose change is of the size of the gap can reach the valley, while one
-    that barely moves χ² cannot explain the gap, however lucky its screening."""
+    that barely moves χ² cannot explain the gap, however lucky its screening.
+    Each place goes to a distinct effect (`distinct`: one candidate per Candidate.quantity): the worn arcs of one
+    joint at twelve angles are one effect, represented by its best member, not twelve chances to take every place."""
     by_screening = sorted(screened, key=lambda s: s.best.chi_square)
-    chosen = by_screening[:count]
+    chosen = distinct(by_screening)[:count]
     lowering = [s for s in screened if low_band_best(s) < baseline.low_band_chi_square - VISIBLE]
-    chosen += [s for s in sorted(lowering, key=low_band_best)[:count] if s not in chosen]
+    chosen += distinct(distinct(sorted(lowering, key=low_band_best))[:count], chosen)
     excess = max(baseline.chi_square - record.effective_samples, 0.0)
 
     def sensitivity(s: Scored) -> float:
         return max(abs(p.chi_square - baseline.chi_square) for p in s.points if p.fit is not None)
 
-    rest = [s for s in by_screening if s not in chosen and sensitivity(s) > VISIBLE]
+    rest = [s for s in distinct(by_screening, chosen) if sensitivity(s) > VISIBLE]
     reaching = [s for s in rest if sensitivity(s) >= excess]
     extra = min(reaching, key=sensitivity) if reaching else max(rest, key=sensitivity, default=None)
     return chosen + ([extra] if extra is not None and excess > 0.0 else [])
+
+
+def distinct(ranked: list[Scored], taken: list[Scored] = ()) -> list[Scored]:
+    """The first of each quantity (Candidate.quantity) in `ranked`, in its order, leaving out the quantities of
+    `taken`: the worn arcs of one joint are represented by the best of them."""
+    seen = {s.candidate.quantity for s in taken}
+    first = []
+    for s in ranked:
+        if s.candidate.quantity not in seen:
+            seen.add(s.candidate.quantity)
+            first.append(s)
+    return first
 
 
 BANDS = (False, True)  # a rough candidate's profile is smoothed in the comparison band and in the screening band
@@ -846,11 +861,8 @@ def candidate_pairs(fitted: list[Scored], baseline: float, count: int = PAIRS) -
     def improvement(s: Scored) -> float:
         return baseline - s.best.chi_square
 
-    def quantity(s: Scored) -> tuple:
-        return s.candidate.kind, s.candidate.target, s.candidate.parameter
-
     usable = [s for s in fitted if s.best is not None]
-    pairs = [(a, b) for i, a in enumerate(usable) for b in usable[i + 1:] if quantity(a) != quantity(b)]
+    pairs = [(a, b) for i, a in enumerate(usable) for b in usable[i + 1:] if a.candidate.quantity != b.candidate.quantity]
     return sorted(pairs, key=lambda pair: -(improvement(pair[0]) + improvement(pair[1])))[:count]
 
 

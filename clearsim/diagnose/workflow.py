@@ -571,8 +571,8 @@ def needle(scored: Scored) -> str | None:
 
 def clearances_of_worn_joints(chosen: list[Scored], visible: list[Scored]) -> list[Scored]:
     """The clearance candidate of each joint a chosen worn arc is in, when not chosen itself: a uniform clearance
-    change is a worn arc's mean term alone, so an arc is judged against it (the twelve arcs of a joint would otherwise
-    take every place to fit)."""
+    change is a worn arc's mean term alone, so an arc is judged against it (the arc fits better only when the record
+    shows a direction)."""
     worn = {s.candidate.target for s in chosen if s.candidate.kind == "wear"}
     return [s for s in visible if s.candidate.kind == "clearance" and s.candidate.target in worn and s not in chosen]
 

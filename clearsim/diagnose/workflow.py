@@ -529,67 +529,33 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
         refine(evaluator, record, sensors, between, document)
         scored += between
         ranked = judge(scored, baseline, record)
-    significant = [s for s in ranked if s.fitted and s.delta_bic < -SIGNIFICANCE]
-    winner = first_real(significant, lambda s: why_luck(evaluator, record, sensors, document, s, base_point, request,
-                                                        number), say)
+    winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
+    if winner is not None and rattles_with(winner, document, request) and not seen_below_chaos(winner, base_point, record):
+        say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) only above the screening band "
+            f"({record.low_band.cutoff:.0f} Hz; there χ² {low_band_best(winner):.1f} against the model's "
+            f"{base_point.low_band_chi_square:.1f}): chaotic detail of the impacts, not a missing effect")
+        winner = None
+    lucky = needle(winner) if winner is not None else None
+    if lucky:
+        say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) but its interval "
+            f"({winner.candidate.shown(winner.interval[0])}–{winner.candidate.shown(winner.interval[1])}) {lucky}: its "
+            "runs scatter as much as it improves, one lucky run, not a missing effect")
+        winner = None
     if winner is not None:
-        place = next(k for k, s in enumerate(ranked) if s is winner)  # the candidates ranked above it were rejected
-        mark_ties(ranked[place:], {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
+        evaluator.stage(f"iteration {number}: re-rolling the impacts {PERTURBATIONS} times")
+        winner.perturbed = perturbed_changes(evaluator, record, sensors, document, winner, base_point, request)
+        if not keeps_its_gain(winner, baseline.chi_square):
+            say(f"  {winner.candidate.label} fits better (Δχ² {winner.estimate.chi_square - baseline.chi_square:.0f}) "
+                f"but only by {median_change(winner):.0f} with the impacts re-rolled (median of {PERTURBATIONS} runs): "
+                "one lucky realisation, not a missing effect")
+            winner = None
+    if winner is not None:
+        mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
         winner.halves = halves_improved(record, base_point, winner.estimate)
         say(f"  found: {effect_line(found_effect(winner, baseline))}")
     else:
         say("  no candidate beats the model significantly")
     return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
-
-
-def first_real(significant: list[Scored], luck: Callable[[Scored], str | None],
-               say: Callable[[str], None]) -> Scored | None:
-    """The best of the significant candidates (ranked) in which `luck` (why_luck) finds no lucky realisation of the
-    impacts, or None. They are judged in the order of the ranking: a candidate rejected is no evidence against the
-    next one, which the same rules judge (each rejection is said)."""
-    for scored in significant:
-        why = luck(scored)
-        if why is None:
-            return scored
-        say(f"  {scored.candidate.label} {why}")
-    return None
-
-
-def why_luck(evaluator, record: Record, sensors: list[str], document: dict, scored: Scored, baseline: Point,
-             request: DiagnoseRequest, number: int) -> str | None:
-    """Why a significant candidate's improvement is one lucky realisation of the impacts, not a missing effect, or
-    None: a rule of docs/diagnose.md §4 step 3 (rejection), else its impacts re-rolled (step 5: lost_gain; the re-rolled
-    runs are kept in scored.perturbed)."""
-    why = rejection(scored, baseline, record, document, request)
-    if why is not None:
-        return why
-    evaluator.stage(f"iteration {number}: re-rolling the impacts of {scored.candidate.label} {PERTURBATIONS} times")
-    scored.perturbed = perturbed_changes(evaluator, record, sensors, document, scored, baseline, request)
-    return lost_gain(scored, baseline.fit.chi_square)
-
-
-def rejection(scored: Scored, baseline: Point, record: Record, document: dict, request: DiagnoseRequest) -> str | None:
-    """Why a significant candidate's best run is luck, not a missing effect, before its impacts are re-rolled (§4 step
-    3), or None: better only above the screening band where a joint rattles (seen_below_chaos), or a needle."""
-    if rattles_with(scored, document, request) and not seen_below_chaos(scored, baseline, record):
-        return (f"fits better (ΔBIC {scored.delta_bic:.0f}) only above the screening band ({record.low_band.cutoff:.0f} Hz; "
-                f"there χ² {low_band_best(scored):.1f} against the model's {baseline.low_band_chi_square:.1f}): chaotic "
-                "detail of the impacts, not a missing effect")
-    lucky = needle(scored)
-    if lucky:
-        return (f"fits better (ΔBIC {scored.delta_bic:.0f}) but its interval ({scored.candidate.shown(scored.interval[0])}–"
-                f"{scored.candidate.shown(scored.interval[1])}) {lucky}: its runs scatter as much as it improves, one "
-                "lucky run, not a missing effect")
-    return None
-
-
-def lost_gain(scored: Scored, baseline_chi_square: float) -> str | None:
-    """Why a candidate whose impacts were re-rolled is luck (search.keeps_its_gain, §4 step 5), or None."""
-    if keeps_its_gain(scored, baseline_chi_square):
-        return None
-    return (f"fits better (Δχ² {scored.estimate.chi_square - baseline_chi_square:.0f}) but only by "
-            f"{median_change(scored):.0f} with the impacts re-rolled (median of {PERTURBATIONS} runs): one lucky "
-            "realisation, not a missing effect")
 
 
 def needle(scored: Scored) -> str | None:

@@ -530,7 +530,8 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
         scored += between
         ranked = judge(scored, baseline, record)
     winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
-    if winner is not None and rattles_with(winner, document, request) and not seen_below_chaos(winner, base_point, record):
+    if (winner is not None and rattles_with(winner, document, request)
+            and not seen_below_chaos(winner, base_point, record)):
         say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) only above the screening band "
             f"({record.low_band.cutoff:.0f} Hz; there χ² {low_band_best(winner):.1f} against the model's "
             f"{base_point.low_band_chi_square:.1f}): chaotic detail of the impacts, not a missing effect")

@@ -35,9 +35,10 @@ and a run at its minimum, the step halved each round.
 When greedy selection finds nothing, `fit_pair` fits a pair of candidates together: a coarse 4 × 4 grid in their unit
 coordinates, then the joint refit's stencil rounds (`refine_jointly`) about its best point.
 
-Candidates are ranked by the Bayesian information criterion BIC = χ²_min + k ln n_eff (k = 1 fitted
-parameter; the trigger offset is fitted in every model alike), so a candidate must lower χ² by more
-than ln n_eff + SIGNIFICANCE to count as found: noise alone does not pass.
+Candidates are ranked by the Bayesian information criterion BIC = χ² + k ln n_eff of the run each reports (its
+lowest; a rough candidate's at its smoothed minimum; k = 1 fitted parameter; the trigger offset is fitted in every
+model alike), so a candidate must lower χ² by more than ln n_eff + SIGNIFICANCE to count as found: noise alone does
+not pass.
 """
 
 from __future__ import annotations
@@ -532,7 +533,8 @@ def judge(scored: list[Scored], baseline: Fit, record: Record) -> list[Scored]:
         if s.best is None:
             continue
         s.allowance = profile_threshold(s.best.chi_square, record)
-        s.bic = s.best.chi_square + penalty * s.candidate.parameters  # the evidence: the best any run did (a rough candidate's estimate is its smoothed minimum)
+        s.bic = s.estimate.chi_square + penalty * s.candidate.parameters  # the evidence: the run reported and added (a
+        # rough candidate's at its smoothed minimum, not the comb's lowest tooth; any other's is its lowest run)
         s.delta_bic = s.bic - baseline.chi_square
         s.interval = interval(s, record) if s.smoothed is None else smoothed_interval(s)
     ranked = sorted(scored, key=lambda s: (not s.fitted, s.bic))

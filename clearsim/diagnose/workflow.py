@@ -357,7 +357,7 @@ def verdict_spread(evaluator, record: Record, document: dict, prediction: Predic
     """The chaotic spread of the final model (search.chaotic_spread) from VERDICT_TWINS twins whose clearance journals
     start VERDICT_PERTURBATION off (seeds VERDICT_SEED + 1, …; one parallel batch); None without a clearance joint."""
     mechanism = _mechanism(document, request)
-    if not any(is_clearance_joint(j) for j in mechanism.joints):
+    if not has_clearance_joint(mechanism):
         return None
     evaluator.stage(f"the verdict: re-rolling the impacts {VERDICT_TWINS} times")
     seeds = range(VERDICT_SEED + 1, VERDICT_SEED + VERDICT_TWINS + 1)
@@ -530,7 +530,8 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
         scored += between
         ranked = judge(scored, baseline, record)
     winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
-    if winner is not None and not seen_below_chaos(winner, base_point, record):
+    if (winner is not None and rattles_with(winner, document, request)
+            and not seen_below_chaos(winner, base_point, record)):
         say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) only above the screening band "
             f"({record.low_band.cutoff:.0f} Hz; there χ² {low_band_best(winner):.1f} against the model's "
             f"{base_point.low_band_chi_square:.1f}): chaotic detail of the impacts, not a missing effect")
@@ -589,7 +590,7 @@ def ensemble_copies(document: dict, request: DiagnoseRequest, runs: int) -> list
     """The document and its runs − 1 perturbed twins (seeds 101, 102, …); without a clearance joint, nothing chaotic to
     re-roll: the document alone."""
     mechanism = _mechanism(document, request)
-    if not any(is_clearance_joint(j) for j in mechanism.joints):
+    if not has_clearance_joint(mechanism):
         return [document]
     return [document] + [perturbed(mechanism, document, ENSEMBLE_SEED + seed) for seed in range(1, runs)]
 
@@ -640,6 +641,19 @@ def perturbed_changes(evaluator, record: Record, sensors: list[str], document: d
 
 def candidates_count(count: int) -> str:
     return f"{count} candidate{'' if count == 1 else 's'}"
+
+
+def has_clearance_joint(mechanism) -> bool:
+    """A clearance joint: impacts whose chaotic sequence a run replays only as one realisation of it."""
+    return any(is_clearance_joint(j) for j in mechanism.joints)
+
+
+def rattles_with(scored: Scored, document: dict, request: DiagnoseRequest) -> bool:
+    """The model with the candidate's estimate has a clearance joint (its own or one the candidate adds): only then can
+    a run match the record's impacts by chance, and only then does seen_below_chaos apply. Without one, a lower χ² in
+    the comparison band alone is the candidate's signature (a drive lag's start-up transient, over before the screening
+    band's compared samples begin), not luck."""
+    return has_clearance_joint(_mechanism(scored.candidate.applied(document, scored.estimate.value), request))
 
 
 def seen_below_chaos(scored: Scored, baseline: Point, record: Record) -> bool:

@@ -122,7 +122,7 @@ def diagnosis_document(d: Diagnosis) -> dict:
                   for pair in d.pairs],
         "found_as_pair": d.found_as_pair,
         "iterations": [{"gap": it.baseline.gap, "found": _effect(found_effect(it.found, it.baseline)) if it.found else None,
-                        "ranking": _ranking(it.ranked),
+                        "rejected": it.rejected or None, "ranking": _ranking(it.ranked),
                         "windows": [{"sensor": w.sensor, "start_s": w.start, "end_s": w.end, "peak_noise_levels": w.peak}
                                     for w in it.windows]} for it in d.iterations],
         "simulations": d.simulations, "wall_time_s": d.wall_time,
@@ -171,8 +171,9 @@ def verdict(d: Diagnosis) -> str:
     named = "; ".join(f"{'missing effect' if confirmed(e, d.check, d.record) else 'not confirmed'}: {effect_line(e)}"
                       for e in d.effects)
     if not d.effects:
-        named = (f"no missing effect found: no candidate lowers the BIC by more than the significance margin; "
-                 f"gap {d.before.gap:.3g}")
+        why = (f"the best candidate is rejected: {d.iterations[-1].rejected}" if d.iterations[-1].rejected
+               else "no candidate lowers the BIC by more than the significance margin")
+        named = f"no missing effect found: {why}; gap {d.before.gap:.3g}"
     return f"{unexplained_line(d)}; {named}" if d.check.unexplained else named
 
 

@@ -76,6 +76,7 @@ class Iteration:
     found: Scored | None
     features: list[Feature]
     windows: list[Window]
+    rejected: str = ""  # why its best candidate, significant by the BIC, is not named (none: "")
 
 
 @dataclass
@@ -530,33 +531,35 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
         scored += between
         ranked = judge(scored, baseline, record)
     winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
+    rejected = ""  # why the significant winner is not named (§4 steps 3 and 5)
     if (winner is not None and rattles_with(winner, document, request)
             and not seen_below_chaos(winner, base_point, record)):
-        say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) only above the screening band "
-            f"({record.low_band.cutoff:.0f} Hz; there χ² {low_band_best(winner):.1f} against the model's "
-            f"{base_point.low_band_chi_square:.1f}): chaotic detail of the impacts, not a missing effect")
-        winner = None
-    lucky = needle(winner) if winner is not None else None
+        rejected = (f"{winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) only above the screening band "
+                    f"({record.low_band.cutoff:.0f} Hz; there χ² {low_band_best(winner):.1f} against the model's "
+                    f"{base_point.low_band_chi_square:.1f}): chaotic detail of the impacts, not a missing effect")
+    lucky = needle(winner) if winner is not None and not rejected else None
     if lucky:
-        say(f"  {winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) but its interval "
-            f"({winner.candidate.shown(winner.interval[0])}–{winner.candidate.shown(winner.interval[1])}) {lucky}: its "
-            "runs scatter as much as it improves, one lucky run, not a missing effect")
-        winner = None
-    if winner is not None:
+        rejected = (f"{winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) but its interval "
+                    f"({winner.candidate.shown(winner.interval[0])}–{winner.candidate.shown(winner.interval[1])}) "
+                    f"{lucky}: its runs scatter as much as it improves, one lucky run, not a missing effect")
+    if winner is not None and not rejected:
         evaluator.stage(f"iteration {number}: re-rolling the impacts {PERTURBATIONS} times")
         winner.perturbed = perturbed_changes(evaluator, record, sensors, document, winner, base_point, request)
         if not keeps_its_gain(winner, baseline.chi_square):
-            say(f"  {winner.candidate.label} fits better (Δχ² {winner.estimate.chi_square - baseline.chi_square:.0f}) "
-                f"but only by {median_change(winner):.0f} with the impacts re-rolled (median of {PERTURBATIONS} runs): "
-                "one lucky realisation, not a missing effect")
-            winner = None
+            rejected = (f"{winner.candidate.label} fits better (Δχ² "
+                        f"{winner.estimate.chi_square - baseline.chi_square:.0f}) but only by {median_change(winner):.0f} "
+                        f"with the impacts re-rolled (median of {PERTURBATIONS} runs): one lucky realisation, not a "
+                        "missing effect")
+    if rejected:
+        say(f"  {rejected}")
+        winner = None
     if winner is not None:
         mark_ties(ranked, {s: float(np.ptp(v)) for s, v in base_prediction.sensors.items()})
         winner.halves = halves_improved(record, base_point, winner.estimate)
         say(f"  found: {effect_line(found_effect(winner, baseline))}")
     else:
         say("  no candidate beats the model significantly")
-    return Iteration(baseline, base_prediction, ranked, winner, found_features, windows)
+    return Iteration(baseline, base_prediction, ranked, winner, found_features, windows, rejected)
 
 
 def needle(scored: Scored) -> str | None:

@@ -134,6 +134,11 @@ def test_a_lucky_rerun_of_an_irrelevant_candidate_is_not_named(tmp_path):
     assert lucky["fitted"] and lucky["delta_bic"] < -SIGNIFICANCE, lucky  # a lucky run the BIC alone would name
     assert found["effects"] == []
     assert "spans the whole range" in result.output and "no missing effect found" in result.output
+    rejected = found["iterations"][0]["rejected"]  # the report says why the candidate the BIC passes is not named
+    assert lucky["target"] in rejected and "spans the whole range" in rejected, rejected
+    report = (tmp_path / "report" / "report.md").read_text()
+    assert f"the best candidate is rejected: {rejected}" in report
+    assert "no candidate lowers the BIC by more than the significance margin" not in report
 
 
 def test_an_effect_whose_re_rolled_runs_lose_its_gain_is_a_lucky_realisation():

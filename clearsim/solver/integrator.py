@@ -90,6 +90,7 @@ SAFETY = 0.9
 PEAK_CANDIDATE = 0.9  # a step's sampled F_n maximum within 10 % of the peak so far is refined
 PEAK_RESOLUTION = 1e-5  # of the step: the peak's location error; F_n is flat there, so its error is ~1e-10
 NORMAL, TANGENTIAL = 0, 1  # the two event functions of a clearance joint
+UNSOLVED = np.nan  # event_value's friction of a sticking joint: not known, solve for it
 SLIDE_HYSTERESIS = 1e-9  # m/s: ε_v of the sliding-stops event, far below any resolved sliding speed
 DECIDE_SPEED = 1e-6  # m/s: below it a contact tests whether it sticks (settle_friction)
 DEEPEST_PENETRATION = 0.05  # of the journal radius: beyond it no contact law means anything
@@ -137,28 +138,15 @@ def stick_frictions(system, dynamics, t, y, modes, speeds, frictions):
 
 
 @njit(cache=True)
-def event_value(system, dynamics, k, kind, t, y, modes, speeds):
+def event_value(system, dynamics, k, kind, t, y, modes, speeds, friction):
     """(g, ġ) of joint k's event function; the event is g crossing 0 (ġ = 0: unknown).
 
     NORMAL: δ in free flight (onset at g ↑ 0), δ + ε in contact (loss at g ↓ 0).
     TANGENTIAL (exact-stick laws in contact): μ_s F_n − |F_t| while sticking (slip at g ↓ 0),
     s v_t + ε_v while sliding in direction s (the sliding stops or reverses at g ↓ 0).
+    friction: F_t of a sticking joint at (t, y) as stick_frictions gives it, or UNSOLVED to solve for it here (a
+    constrained solve of the whole state); the other event functions read the joint's two bodies alone.
     """
-    if needs_stick_solve(system, k, kind, modes):
-        return friction_reserve(system, dynamics, t, y, modes, speeds, k)[0], 0.0
-    return known_event_value(system, k, kind, y, modes, speeds, 0.0)
-
-
-@njit(cache=True, inline="always")
-def needs_stick_solve(system, k, kind, modes):
-    """Joint k's event function of this kind is a sticking joint's friction reserve, which takes a constrained solve
-    of the whole state (every other event function reads the joint's two bodies alone)."""
-    return kind == TANGENTIAL and modes[k] == STICK and exact_stick(system, k)
-
-
-@njit(cache=True, inline="always")
-def known_event_value(system, k, kind, y, modes, speeds, friction):
-    """event_value with the friction force F_t of a sticking joint given (stick_frictions; ignored otherwise)."""
     n = coordinate_count(system)
     mode = modes[k]
     if kind == NORMAL:
@@ -168,9 +156,18 @@ def known_event_value(system, k, kind, y, modes, speeds, friction):
     if mode == FREE or not exact_stick(system, k):
         return 1.0, 0.0
     if mode == STICK:
+        if friction != friction:  # UNSOLVED
+            return friction_reserve(system, dynamics, t, y, modes, speeds, k)[0], 0.0
         return reserve_left(system, k, y, modes, speeds, friction)[0], 0.0
     direction = -1.0 if mode == SLIDE_BACK else 1.0
     return direction * clearance_kinematics(system, k, y[:n], y[n:2 * n])[8] + SLIDE_HYSTERESIS, 0.0
+
+
+@njit(cache=True, inline="always")
+def needs_stick_solve(system, k, kind, modes):
+    """Joint k's event function of this kind is a sticking joint's friction reserve, which takes a constrained solve
+    of the whole state (every other event function reads the joint's two bodies alone)."""
+    return kind == TANGENTIAL and modes[k] == STICK and exact_stick(system, k)
 
 
 @njit(cache=True)
@@ -183,7 +180,7 @@ def interpolate(y, stages, h, theta, out):
         dense_output(y, stages, DENSE, h, theta, out)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def interpolate_joint(system, k, y, stages, h, theta, out):
     """q and q̇ of joint k's two bodies on the step's continuous extension (interpolate's bits) into their places in
     out, the rest of out left as it is: all that the joint's kinematics, contact force and event functions but the
@@ -194,11 +191,11 @@ def interpolate_joint(system, k, y, stages, h, theta, out):
         dense = DENSE
     weights = dense_weights(dense, h, theta)
     n = coordinate_count(system)
-    for slot in range(2):
-        body = system.clearance_bodies[k, slot]
+    for part in range(4):  # the bearing's q, its q̇, the journal's q, its q̇
+        body = system.clearance_bodies[k, part // 2]
         if body >= 0:
-            dense_elements(y, stages, dense, weights, 3 * body, 3 * body + 3, out)
-            dense_elements(y, stages, dense, weights, n + 3 * body, n + 3 * body + 3, out)
+            first = (part % 2) * n + 3 * body
+            dense_elements(y, stages, dense, weights, first, first + 3, out)
 
 
 @njit(cache=True, inline="always")
@@ -214,7 +211,7 @@ def _value_at(system, dynamics, k, kind, t, y, stages, h, theta, modes, speeds, 
         interpolate(y, stages, h, theta, scratch)
     else:
         interpolate_joint(system, k, y, stages, h, theta, scratch)
-    return event_value(system, dynamics, k, kind, t + theta * h, scratch, modes, speeds)
+    return event_value(system, dynamics, k, kind, t + theta * h, scratch, modes, speeds, UNSOLVED)
 
 
 @njit(cache=True, inline="always")
@@ -267,14 +264,14 @@ def first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, frict
     mode = modes[k]
     if kind == TANGENTIAL and (mode == FREE or not exact_stick(system, k)):
         return 2.0
-    g_prev, r_prev = known_event_value(system, k, kind, y, modes, speeds, frictions[0, k])
+    g_prev, r_prev = event_value(system, dynamics, k, kind, t, y, modes, speeds, frictions[0, k])
     theta_prev = 0.0
     for i in range(1, SUBDIVISIONS + 1):
         theta = i / SUBDIVISIONS
         if i == SUBDIVISIONS:
-            g, r = known_event_value(system, k, kind, y_new, modes, speeds, frictions[i, k])
+            g, r = event_value(system, dynamics, k, kind, t + h, y_new, modes, speeds, frictions[i, k])
         else:
-            g, r = known_event_value(system, k, kind, points[i], modes, speeds, frictions[i, k])
+            g, r = event_value(system, dynamics, k, kind, t + theta * h, points[i], modes, speeds, frictions[i, k])
         if _crossed(mode, kind, g_prev, g):
             return _root(system, dynamics, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
         turning = (r_prev > 0.0 and r < 0.0) if mode == FREE else (r_prev < 0.0 and r > 0.0)
@@ -307,10 +304,14 @@ def earliest_event(system, dynamics, t, y, y_new, stages, h, points, frictions, 
 def fill_stick_frictions(system, dynamics, t, y, y_new, h, points, modes, speeds, frictions):
     """frictions[i, k] ← F_t of each sticking joint k at the step's point i (its start y, its subdivisions, its end
     y_new), where first_event reads them: one solve a point for every sticking joint (stick_frictions)."""
-    stick_frictions(system, dynamics, t, y, modes, speeds, frictions[0])
-    for i in range(1, SUBDIVISIONS):
-        stick_frictions(system, dynamics, t + i / SUBDIVISIONS * h, points[i], modes, speeds, frictions[i])
-    stick_frictions(system, dynamics, t + h, y_new, modes, speeds, frictions[SUBDIVISIONS])
+    for i in range(SUBDIVISIONS + 1):
+        if i == 0:
+            state, time = y, t
+        elif i == SUBDIVISIONS:
+            state, time = y_new, t + h
+        else:
+            state, time = points[i], t + i / SUBDIVISIONS * h
+        stick_frictions(system, dynamics, time, state, modes, speeds, frictions[i])
 
 
 @njit(cache=True)
@@ -480,7 +481,7 @@ def consistent_modes(system, dynamics, projection, mode_switch, t, y, modes, spe
             if needs_stick_solve(system, k, kind, modes) and not solved:
                 stick_frictions(system, dynamics, t, y, modes, speeds, frictions)
                 solved = True
-            g = known_event_value(system, k, kind, y, modes, speeds, frictions[k])[0]
+            g = event_value(system, dynamics, k, kind, t, y, modes, speeds, frictions[k])[0]
             if g > 0.0 if (kind == NORMAL and modes[k] == FREE) else g < 0.0:
                 h = min(h, mode_switch(system, dynamics, projection, k, kind, t, y, modes, speeds, episode_of, real,
                                        ints, log_joint, log_onset, log_loss, log_speed, log_mass))
@@ -646,7 +647,7 @@ def refine_event(system, dynamics, projection, implicit_step, k, kind, t, y, f, 
         projection(system, t + h_event, y_event, modes)
         if kind == TANGENTIAL:
             break
-        g, rate = event_value(system, dynamics, k, kind, t + h_event, y_event, modes, speeds)
+        g, rate = event_value(system, dynamics, k, kind, t + h_event, y_event, modes, speeds, UNSOLVED)
         if abs(g) <= tolerance or rate == 0.0:
             break
         h_event = min(max(h_event - g / rate, 0.5 * h_event), 2.0 * h_event)

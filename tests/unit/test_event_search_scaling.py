@@ -41,6 +41,23 @@ def _counting(system, t, q, qd, z, modes, speeds):
     return dry_forces_and_accelerations(system, t, q, qd, z, modes, speeds)
 
 
+def _reserves(system, dynamics, y, modes, speeds):
+    """(each sticking joint's reserve from the shared solve, from a solve of its own)."""
+    frictions = np.zeros(modes.shape[0])
+    ig.stick_frictions(system, dynamics, 0.0, y, modes, speeds, frictions)
+    shared, alone = np.zeros(modes.shape[0]), np.zeros(modes.shape[0])
+    for k in range(modes.shape[0]):
+        shared[k] = ig.reserve_left(system, k, y, modes, speeds, frictions[k])[0]
+        alone[k] = ig.friction_reserve(system, dynamics, 0.0, y, modes, speeds, k)[0]
+    return shared, alone
+
+
+def _values(system, dynamics, k, kind, y, stages, h, theta, modes, speeds, scratch, full):
+    """(the event search's value at θ, interpolating into scratch; event_value on the whole interpolated state)."""
+    return (ig._value_at(system, dynamics, k, kind, 0.0, y, stages, h, theta, modes, speeds, scratch),
+            ig.event_value(system, dynamics, k, kind, theta * h, full, modes, speeds, ig.UNSOLVED))
+
+
 def _earliest(system, dynamics, t, y, stages, h, modes, speeds):
     points = np.empty((ig.SUBDIVISIONS + 1, y.shape[0]))
     frictions = np.zeros((ig.SUBDIVISIONS + 1, modes.shape[0]))
@@ -51,18 +68,21 @@ def _earliest(system, dynamics, t, y, stages, h, modes, speeds):
 
 @functools.cache
 def kernels(system_type):
-    """(a dynamics that records its calls, the event search over a step) compiled with the dynamics typed as the loop
-    types it, a function by address (a kernel cached for a dispatcher object would fail to save its cache index)."""
+    """(a dynamics that records its calls, the event search over a step, _reserves, _values) compiled with the dynamics
+    typed as the loop types it, a function by address (a kernel cached for a dispatcher object would fail to save its
+    cache index)."""
     dynamics = dynamics_type(system_type)
     counting = njit(dynamics.signature)(_counting)
-    V, IV, F = types.float64[::1], types.int64[::1], types.float64
-    search = njit((system_type, dynamics, F, V, types.float64[:, ::1], F, IV, V))(_earliest)
-    return counting, search
+    V, IV, F, I, M = types.float64[::1], types.int64[::1], types.float64, types.int64, types.float64[:, ::1]
+    search = njit((system_type, dynamics, F, V, M, F, IV, V))(_earliest)
+    reserves = njit((system_type, dynamics, V, IV, V))(_reserves)
+    values = njit((system_type, dynamics, I, I, V, M, F, F, IV, V, V, V))(_values)
+    return counting, search, reserves, values
 
 
 def test_the_event_search_solves_once_a_point_for_all_sticking_joints():
     system, y, stages, modes, speeds = state(chain_run(), STICK)
-    counting, search = kernels(typeof(system))
+    counting, search = kernels(typeof(system))[:2]
     DYNAMICS_CALLS.clear()
     search(system, counting, 0.0, y, np.zeros_like(stages), 1e-6, modes, speeds)  # no motion: no event to refine
     assert len(DYNAMICS_CALLS) == ig.SUBDIVISIONS + 1  # one a point (start, subdivisions, end), not one a joint
@@ -70,11 +90,10 @@ def test_the_event_search_solves_once_a_point_for_all_sticking_joints():
 
 def test_the_shared_solve_gives_each_joints_own_friction_reserve_bit_for_bit():
     system, y, _, modes, speeds = state(chain_run(), STICK)
-    frictions = np.zeros(modes.shape[0])
-    ig.stick_frictions(system, dry_forces_and_accelerations, 0.0, y, modes, speeds, frictions)
-    for k in range(modes.shape[0]):
-        alone = ig.friction_reserve(system, dry_forces_and_accelerations, 0.0, y, modes, speeds, k)
-        assert ig.reserve_left(system, k, y, modes, speeds, frictions[k]) == alone
+    reserves = kernels(typeof(system))[2]
+    shared, alone = reserves(system, dry_forces_and_accelerations, y, modes, speeds)
+    assert np.all(np.isfinite(alone))
+    assert np.array_equal(shared, alone)
 
 
 def test_the_searches_interpolate_only_the_joints_two_bodies():
@@ -82,18 +101,18 @@ def test_the_searches_interpolate_only_the_joints_two_bodies():
     n = 3 * LINKS
     full = np.empty_like(y)
     ig.interpolate(y, stages, 1e-4, 0.3, full)
+    values = kernels(typeof(system))[3]
     for k in range(modes.shape[0]):
         for kind in (ig.NORMAL, ig.TANGENTIAL):
             scratch = np.full_like(y, np.nan)
-            value = ig._value_at(system, dry_forces_and_accelerations, k, kind, 0.0, y, stages, 1e-4, 0.3, modes,
-                                 speeds, scratch)
+            value, whole = values(system, dry_forces_and_accelerations, k, kind, y, stages, 1e-4, 0.3, modes, speeds,
+                                  scratch, full)
             written = np.flatnonzero(~np.isnan(scratch))
             bodies = [b for b in system_bodies(chain_run(), k) if b >= 0]
             expected = sorted(c for b in bodies for c in (*range(3 * b, 3 * b + 3), *range(n + 3 * b, n + 3 * b + 3)))
             assert written.tolist() == expected  # 12 entries whatever the chain's length
             assert np.array_equal(scratch[written], full[written])
-            assert value == ig.event_value(system, dry_forces_and_accelerations, k, kind, 0.3 * 1e-4, full, modes,
-                                          speeds)
+            assert value == whole
         scratch = np.full_like(y, np.nan)
         force = ig.normal_force_at(system, k, y, stages, 1e-4, 0.3, modes, speeds, scratch)
         assert np.count_nonzero(~np.isnan(scratch)) == 12

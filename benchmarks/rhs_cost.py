@@ -2,6 +2,7 @@
 
     python -m benchmarks.rhs_cost                          # the bundled breaker at 60 ms and the slider-crank
     python -m benchmarks.rhs_cost --json benchmarks/results/rhs-cost.json
+    python -m benchmarks.rhs_cost --chains 64,128,256,512 --cpu   # pendulum chains, K = N/2, at 20 ms, CPU time
 
 A model is integrated to a time in its stroke (the breaker at 60 ms: both joints in contact); at the state reached
 each kernel of the right-hand side is called in a compiled loop (`count` calls, the minimum over `repeats` timings of
@@ -17,7 +18,9 @@ event).
 from __future__ import annotations
 
 import argparse
+import functools
 import json
+import tempfile
 import time
 from pathlib import Path
 
@@ -304,29 +307,32 @@ def refinement(run, system, steps=(1e-6, 1e-5, 1e-4), count: int = 5000, repeats
                                                        True)
         rows[f"{h:g}"] = {
             "cg_iterations": gradient_iterations,
-            "cg_us": _microseconds(lambda c: _time_refined(system, q, q_new, qd, modes, b, 4 * np.finfo(float).eps, c,
+            "cg_us": _timed(lambda c: _time_refined(system, q, q_new, qd, modes, b, 4 * np.finfo(float).eps, c,
                                                            True), count, repeats),
             "cg_relative_difference": float(np.max(np.abs(gradients - fresh)) / np.max(np.abs(fresh))),
             "iterations": iterations,
-            "refined_us": _microseconds(lambda c: _time_refined(system, q, q_new, qd, modes, b,
+            "refined_us": _timed(lambda c: _time_refined(system, q, q_new, qd, modes, b,
                                                                 4 * np.finfo(float).eps, c), count, repeats),
-            "fresh_us": _microseconds(lambda c: _time_fresh(system, q, q_new, qd, modes, b, c), count, repeats),
+            "fresh_us": _timed(lambda c: _time_fresh(system, q, q_new, qd, modes, b, c), count, repeats),
             "relative_difference": float(np.max(np.abs(refined - fresh)) / np.max(np.abs(fresh)))}
     return rows
 
 
-def _microseconds(call, count: int, repeats: int) -> float:
+def _timed(call, count: int, repeats: int, clock=time.perf_counter) -> float:
     call(1)
     best = np.inf
     for _ in range(repeats):
-        started = time.perf_counter()
+        started = clock()
         call(count)
-        best = min(best, time.perf_counter() - started)
+        best = min(best, clock() - started)
     return best / count * 1e6
 
 
-def breakdown(run, system, dynamics, count: int = 20000, repeats: int = 7) -> dict:
-    """µs per call of the right-hand side and of its parts at the run's state (module docstring)."""
+def breakdown(run, system, dynamics, count: int = 20000, repeats: int = 7, clock=time.perf_counter) -> dict:
+    """µs per call of the right-hand side and of its parts at the run's state (module docstring), timed by `clock`
+    (time.process_time: the process's CPU time, which on a shared machine leaves out the waits for a core)."""
+    timed = functools.partial(_timed, clock=clock)
+
     n = run.coordinate_count
     t, y = run.time, run.y.copy()
     other = y.copy()
@@ -338,8 +344,8 @@ def breakdown(run, system, dynamics, count: int = 20000, repeats: int = 7) -> di
     rows = m + int(np.sum(modes == STICK))
     blocks, bodies = np.zeros((m, 2, 3)), np.zeros((m, 2), np.int64)
     time_rhs = _rhs_timer(system)
-    rhs_new = _microseconds(lambda c: time_rhs(system, dynamics, t, y, other, modes, speeds, ydot, c), count, repeats)
-    rhs_same = _microseconds(lambda c: time_rhs(system, dynamics, t, y, y, modes, speeds, ydot, c), count, repeats)
+    rhs_new = timed(lambda c: time_rhs(system, dynamics, t, y, other, modes, speeds, ydot, c), count, repeats)
+    rhs_same = timed(lambda c: time_rhs(system, dynamics, t, y, y, modes, speeds, ydot, c), count, repeats)
     time_rhs(system, dynamics, t, y, y, modes, speeds, ydot, 1)
     force = np.zeros(n)
     force[:] = ydot[n:2 * n]  # any force will do for the timing
@@ -347,21 +353,21 @@ def breakdown(run, system, dynamics, count: int = 20000, repeats: int = 7) -> di
     zdot = np.zeros_like(z)
     lam = np.ones(rows)
     parts = {
-        "jacobian_blocks": _microseconds(lambda c: _time_jacobian(system, q, other[:n], blocks, bodies, c), count,
+        "jacobian_blocks": timed(lambda c: _time_jacobian(system, q, other[:n], blocks, bodies, c), count,
                                          repeats),
-        "stick_rows": _microseconds(lambda c: _time_stick_rows(system, q, other[:n], qd, modes, c), count, repeats),
-        "schur_complement": _microseconds(lambda c: _time_schur(system, blocks, bodies, c), count, repeats),
-        "factorize": _microseconds(lambda c: _time_factorize(system, m, c), count, repeats),
-        "gamma": _microseconds(lambda c: _time_gamma(system, t, q, other[:n], qd, gamma[:m], c), count, repeats),
-        "constrained_response": _microseconds(lambda c: _time_response(system, q, qd, modes, force, gamma, c), count,
+        "stick_rows": timed(lambda c: _time_stick_rows(system, q, other[:n], qd, modes, c), count, repeats),
+        "schur_complement": timed(lambda c: _time_schur(system, blocks, bodies, c), count, repeats),
+        "factorize": timed(lambda c: _time_factorize(system, m, c), count, repeats),
+        "gamma": timed(lambda c: _time_gamma(system, t, q, other[:n], qd, gamma[:m], c), count, repeats),
+        "constrained_response": timed(lambda c: _time_response(system, q, qd, modes, force, gamma, c), count,
                                               repeats),
-        "clearance_forces": _microseconds(lambda c: _time_clearance(system, q, qd, modes, speeds, c), count, repeats),
-        "applied_and_driveline_forces": _microseconds(lambda c: _time_applied(system, t, q, qd, c), count, repeats),
-        "hydraulics": _microseconds(lambda c: _time_hydraulics(system, t, q, qd, z, zdot, c), count, repeats),
-        "powers_and_wear_rates": _microseconds(lambda c: _time_powers(system, t, q, qd, lam, modes, speeds, zdot, c),
+        "clearance_forces": timed(lambda c: _time_clearance(system, q, qd, modes, speeds, c), count, repeats),
+        "applied_and_driveline_forces": timed(lambda c: _time_applied(system, t, q, qd, c), count, repeats),
+        "hydraulics": timed(lambda c: _time_hydraulics(system, t, q, qd, z, zdot, c), count, repeats),
+        "powers_and_wear_rates": timed(lambda c: _time_powers(system, t, q, qd, lam, modes, speeds, zdot, c),
                                                count, repeats),
     }
-    accelerations_new = _microseconds(lambda c: _time_accelerations(system, t, q, other[:n], qd, force, modes, c),
+    accelerations_new = timed(lambda c: _time_accelerations(system, t, q, other[:n], qd, force, modes, c),
                                       count, repeats)
     return {"t_ms": t * 1e3, "modes": [int(mode) for mode in modes], "rows": rows,
             "rhs_new_q_us": rhs_new, "rhs_same_q_us": rhs_same, "accelerations_new_q_us": accelerations_new,
@@ -386,19 +392,44 @@ def rhs_accounting(config: Path, overrides: list[str] | None = None) -> dict:
             "step_end_rhs": steps, "other_rhs": evaluations - 7 * steps - 6 * rejected}
 
 
+def chain_breakdowns(sizes, count: int, repeats: int, clock, t_state: float = 0.020) -> dict:
+    """breakdown of the N-link pendulum chain with K = N/2 clearance joints at t_state for each N, count / N calls a
+    timing (at least 400), so that each timing takes about as long."""
+    from benchmarks.chain import pendulum_chain
+
+    results = {}
+    with tempfile.TemporaryDirectory(prefix="clearsim-rhs-cost-") as folder:
+        for links in sizes:
+            config = Path(folder) / f"chain-{links}.yaml"
+            config.write_text(pendulum_chain(links, links // 2, t_state))
+            run, system, dynamics = state_at(config, t_state)
+            results[f"chain-{links}"] = breakdown(run, system, dynamics, max(400, 20 * count // links), repeats, clock)
+    return results
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--cases", default=",".join(CASES))
     parser.add_argument("--count", type=int, default=20000)
     parser.add_argument("--repeats", type=int, default=7)
     parser.add_argument("--json", type=Path)
+    parser.add_argument("--chains", help="instead of --cases: the pendulum chains (benchmarks/chain.py) of these link "
+                        "counts N, K = N/2 clearance joints, at their state at 20 ms (the parts alone)")
+    parser.add_argument("--cpu", action="store_true", help="time by the process's CPU time, not the wall clock")
     args = parser.parse_args(argv)
+    clock = time.process_time if args.cpu else time.perf_counter
+    if args.chains:
+        results = chain_breakdowns([int(n) for n in args.chains.split(",")], args.count, args.repeats, clock)
+        print(json.dumps(results, indent=1))
+        if args.json:
+            args.json.write_text(json.dumps(results, indent=1) + "\n")
+        return 0
     results = {}
     for name in args.cases.split(","):
         config, t_state = CASES[name]
         run, system, dynamics = state_at(config, t_state)
         print(name, "state at", run.time, "modes", run.modes, flush=True)
-        result = breakdown(run, system, dynamics, args.count, args.repeats)
+        result = breakdown(run, system, dynamics, args.count, args.repeats, clock)
         result["refinement"] = refinement(run, system)
         print(name, "refinement", result["refinement"], flush=True)
         result["accounting"] = rhs_accounting(config)

@@ -95,6 +95,12 @@ def dense_output(y, stages, dense, h, theta, out):
     """y(t + θh) = y + h Σ_j K_j Σ_p dense_jp θ^(p+1) into out (one pass, no temporaries; each element sums its stages
     in order): the continuous extension of a method whose stage weights are the polynomials of `dense`. Inlined, so
     that a method's own table is a constant there, its loops of known length (as fast as a loop written for it)."""
+    dense_elements(y, stages, dense, dense_weights(dense, h, theta), 0, out.shape[0], out)
+
+
+@njit(cache=True, inline="always")
+def dense_weights(dense, h, theta):
+    """h Σ_p dense_jp θ^(p+1) of each stage j (exactly 0 where the polynomial is)."""
     weights = np.empty(dense.shape[0])
     for j in range(dense.shape[0]):
         weight = 0.0
@@ -103,7 +109,14 @@ def dense_output(y, stages, dense, h, theta, out):
             weight += dense[j, p] * power
             power *= theta
         weights[j] = h * weight if weight != 0.0 else 0.0
-    for i in range(out.shape[0]):
+    return weights
+
+
+@njit(cache=True, inline="always")
+def dense_elements(y, stages, dense, weights, first, end, out):
+    """out[i] = y[i] + Σ_j weights_j K_j[i] for first ≤ i < end (weights: dense_weights of the table `dense`, whose
+    length bounds the loop), the stages summed in order: the same bits as dense_output's element i."""
+    for i in range(first, end):
         value = y[i]
         for j in range(dense.shape[0]):
             if weights[j] != 0.0:

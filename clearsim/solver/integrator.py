@@ -42,9 +42,9 @@ from clearsim.assembly.arrays import (
     CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_STIFFNESS, copy_into,
 )
 from clearsim.assembly.dynamics import (
-    WORK_COUNT, coordinate_count, dry_forces_and_accelerations, dynamics_kernel, dynamics_type, effective_mass,
-    element_states, films_kernel, films_type, forces_and_accelerations, project_positions, project_velocities, rhs,
-    stick_row_index, wear_state_count,
+    WORK_COUNT, constraint_count, coordinate_count, dry_forces_and_accelerations, dynamics_kernel, dynamics_type,
+    effective_mass, element_states, films_kernel, films_type, forces_and_accelerations, project_positions,
+    project_velocities, rhs, stick_count, stick_row_index, wear_state_count,
 )
 from clearsim.assembly.forces import (
     CONTACT, FREE, SLIDE_BACK, STICK, clearance_kinematics, contact_force_magnitudes, exact_stick,
@@ -53,7 +53,7 @@ from clearsim.physics.contact import HERTZ_CONTACT_TIME_FACTOR
 from clearsim.physics.cylindrical import is_power_law, law_max_penetration
 from clearsim.physics.friction import static_coefficient
 from clearsim.solver import dop853, rosenbrock
-from clearsim.solver.dopri import DENSE, STAGES, dense_output, error_norm, step
+from clearsim.solver.dopri import DENSE, STAGES, dense_elements, dense_output, dense_weights, error_norm, step
 from clearsim.solver.samples import derive_sample
 
 # real_state slots
@@ -90,6 +90,7 @@ SAFETY = 0.9
 PEAK_CANDIDATE = 0.9  # a step's sampled F_n maximum within 10 % of the peak so far is refined
 PEAK_RESOLUTION = 1e-5  # of the step: the peak's location error; F_n is flat there, so its error is ~1e-10
 NORMAL, TANGENTIAL = 0, 1  # the two event functions of a clearance joint
+UNSOLVED = np.nan  # event_value's friction of a sticking joint: not known, solve for it
 SLIDE_HYSTERESIS = 1e-9  # m/s: ε_v of the sliding-stops event, far below any resolved sliding speed
 DECIDE_SPEED = 1e-6  # m/s: below it a contact tests whether it sticks (settle_friction)
 DEEPEST_PENETRATION = 0.05  # of the journal radius: beyond it no contact law means anything
@@ -106,22 +107,45 @@ def hysteresis(system, k):
 def friction_reserve(system, dynamics, t, y, modes, speeds, k):
     """(μ_s F_n − |F_t|, F_t) of sticking joint k: the friction force its stick constraint needs, and what is left."""
     n = coordinate_count(system)
-    q = y[:n]
-    qd = y[n:2 * n]
-    friction = -dynamics(system, t, q, qd, element_states(system, y), modes, speeds)[1][stick_row_index(system, modes, k)]
-    kin = clearance_kinematics(system, k, q, qd)
+    friction = -dynamics(system, t, y[:n], y[n:2 * n], element_states(system, y), modes, speeds)[1][
+        stick_row_index(system, modes, k)]
+    return reserve_left(system, k, y, modes, speeds, friction)
+
+
+@njit(cache=True, inline="always")
+def reserve_left(system, k, y, modes, speeds, friction):
+    """(μ_s F_n − |F_t|, F_t) of sticking joint k in state y, whose stick constraint needs the friction force F_t."""
+    n = coordinate_count(system)
+    kin = clearance_kinematics(system, k, y[:n], y[n:2 * n])
     normal = contact_force_magnitudes(system, k, kin[4], kin[5], kin[8], modes[k], speeds[k])[0]
     p = system.clearance_params[k]
     return static_coefficient(system.clearance_laws[k, 1], p[CL_MU_S], p[CL_MU_D]) * normal - abs(friction), friction
 
 
 @njit(cache=True)
-def event_value(system, dynamics, k, kind, t, y, modes, speeds):
+def stick_frictions(system, dynamics, t, y, modes, speeds, frictions):
+    """frictions[k] ← F_t of every sticking joint k at (t, y), −λ of its stick row: one constrained solve for all of
+    them (friction_reserve's solve, once per state instead of once per sticking joint); nothing when none sticks."""
+    if stick_count(modes) == 0:
+        return
+    n = coordinate_count(system)
+    multipliers = dynamics(system, t, y[:n], y[n:2 * n], element_states(system, y), modes, speeds)[1]
+    row = constraint_count(system)
+    for k in range(modes.shape[0]):
+        if modes[k] == STICK:
+            frictions[k] = -multipliers[row]
+            row += 1
+
+
+@njit(cache=True)
+def event_value(system, dynamics, k, kind, t, y, modes, speeds, friction):
     """(g, ġ) of joint k's event function; the event is g crossing 0 (ġ = 0: unknown).
 
     NORMAL: δ in free flight (onset at g ↑ 0), δ + ε in contact (loss at g ↓ 0).
     TANGENTIAL (exact-stick laws in contact): μ_s F_n − |F_t| while sticking (slip at g ↓ 0),
     s v_t + ε_v while sliding in direction s (the sliding stops or reverses at g ↓ 0).
+    friction: F_t of a sticking joint at (t, y) as stick_frictions gives it, or UNSOLVED to solve for it here (a
+    constrained solve of the whole state); the other event functions read the joint's two bodies alone.
     """
     n = coordinate_count(system)
     mode = modes[k]
@@ -132,9 +156,18 @@ def event_value(system, dynamics, k, kind, t, y, modes, speeds):
     if mode == FREE or not exact_stick(system, k):
         return 1.0, 0.0
     if mode == STICK:
-        return friction_reserve(system, dynamics, t, y, modes, speeds, k)[0], 0.0
+        if friction != friction:  # UNSOLVED
+            return friction_reserve(system, dynamics, t, y, modes, speeds, k)[0], 0.0
+        return reserve_left(system, k, y, modes, speeds, friction)[0], 0.0
     direction = -1.0 if mode == SLIDE_BACK else 1.0
     return direction * clearance_kinematics(system, k, y[:n], y[n:2 * n])[8] + SLIDE_HYSTERESIS, 0.0
+
+
+@njit(cache=True, inline="always")
+def needs_stick_solve(system, k, kind, modes):
+    """Joint k's event function of this kind is a sticking joint's friction reserve, which takes a constrained solve
+    of the whole state (every other event function reads the joint's two bodies alone)."""
+    return kind == TANGENTIAL and modes[k] == STICK and exact_stick(system, k)
 
 
 @njit(cache=True)
@@ -148,6 +181,24 @@ def interpolate(y, stages, h, theta, out):
 
 
 @njit(cache=True, inline="always")
+def interpolate_joint(system, k, y, stages, h, theta, out):
+    """q and q̇ of joint k's two bodies on the step's continuous extension (interpolate's bits) into their places in
+    out, the rest of out left as it is: all that the joint's kinematics, contact force and event functions but the
+    friction reserve read, at O(1) cost instead of the whole state's O(bodies)."""
+    if stages.shape[0] == dop853.STAGES:
+        dense = dop853.DENSE
+    else:
+        dense = DENSE
+    weights = dense_weights(dense, h, theta)
+    n = coordinate_count(system)
+    for part in range(4):  # the bearing's q, its q̇, the journal's q, its q̇
+        body = system.clearance_bodies[k, part // 2]
+        if body >= 0:
+            first = (part % 2) * n + 3 * body
+            dense_elements(y, stages, dense, weights, first, first + 3, out)
+
+
+@njit(cache=True, inline="always")
 def _crossed(mode, kind, before, after):
     if kind == NORMAL and mode == FREE:
         return before < 0.0 and after >= 0.0
@@ -156,8 +207,11 @@ def _crossed(mode, kind, before, after):
 
 @njit(cache=True)
 def _value_at(system, dynamics, k, kind, t, y, stages, h, theta, modes, speeds, scratch):
-    interpolate(y, stages, h, theta, scratch)
-    return event_value(system, dynamics, k, kind, t + theta * h, scratch, modes, speeds)
+    if needs_stick_solve(system, k, kind, modes):
+        interpolate(y, stages, h, theta, scratch)
+    else:
+        interpolate_joint(system, k, y, stages, h, theta, scratch)
+    return event_value(system, dynamics, k, kind, t + theta * h, scratch, modes, speeds, UNSOLVED)
 
 
 @njit(cache=True, inline="always")
@@ -203,20 +257,21 @@ def _root(system, dynamics, k, kind, t, y, stages, h, lo, hi, modes, speeds, scr
 
 
 @njit(cache=True, inline="always")
-def first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, modes, speeds, scratch):
+def first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, frictions, modes, speeds, scratch):
     """θ in (0, 1] of joint k's first event of this kind in the step, or 2.0 when there is none (points: the step's
-    continuous extension at its subdivisions, fill_subdivisions)."""
+    continuous extension at its subdivisions, fill_subdivisions; frictions: the sticking joints' F_t there,
+    fill_stick_frictions)."""
     mode = modes[k]
     if kind == TANGENTIAL and (mode == FREE or not exact_stick(system, k)):
         return 2.0
-    g_prev, r_prev = event_value(system, dynamics, k, kind, t, y, modes, speeds)
+    g_prev, r_prev = event_value(system, dynamics, k, kind, t, y, modes, speeds, frictions[0, k])
     theta_prev = 0.0
     for i in range(1, SUBDIVISIONS + 1):
         theta = i / SUBDIVISIONS
         if i == SUBDIVISIONS:
-            g, r = event_value(system, dynamics, k, kind, t + h, y_new, modes, speeds)
+            g, r = event_value(system, dynamics, k, kind, t + h, y_new, modes, speeds, frictions[i, k])
         else:
-            g, r = event_value(system, dynamics, k, kind, t + theta * h, points[i], modes, speeds)
+            g, r = event_value(system, dynamics, k, kind, t + theta * h, points[i], modes, speeds, frictions[i, k])
         if _crossed(mode, kind, g_prev, g):
             return _root(system, dynamics, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
         turning = (r_prev > 0.0 and r < 0.0) if mode == FREE else (r_prev < 0.0 and r > 0.0)
@@ -230,17 +285,33 @@ def first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, modes
 
 
 @njit(cache=True, inline="always")
-def earliest_event(system, dynamics, t, y, y_new, stages, h, points, modes, speeds, scratch):
+def earliest_event(system, dynamics, t, y, y_new, stages, h, points, frictions, modes, speeds, scratch):
     """(θ, joint, kind) of the step's first event, or (2.0, −1, NORMAL) when there is none."""
+    fill_stick_frictions(system, dynamics, t, y, y_new, h, points, modes, speeds, frictions)
     event_theta = 2.0
     event_joint = np.int64(-1)  # int64 from the start: a literal would compile each callee once more for it
     event_kind = np.int64(NORMAL)
     for k in range(modes.shape[0]):
         for kind in range(2):
-            theta = first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, modes, speeds, scratch)
+            theta = first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, frictions, modes, speeds,
+                                scratch)
             if theta < event_theta:
                 event_theta, event_joint, event_kind = theta, k, kind
     return event_theta, event_joint, event_kind
+
+
+@njit(cache=True, inline="always")
+def fill_stick_frictions(system, dynamics, t, y, y_new, h, points, modes, speeds, frictions):
+    """frictions[i, k] ← F_t of each sticking joint k at the step's point i (its start y, its subdivisions, its end
+    y_new), where first_event reads them: one solve a point for every sticking joint (stick_frictions)."""
+    for i in range(SUBDIVISIONS + 1):
+        if i == 0:
+            state, time = y, t
+        elif i == SUBDIVISIONS:
+            state, time = y_new, t + h
+        else:
+            state, time = points[i], t + i / SUBDIVISIONS * h
+        stick_frictions(system, dynamics, time, state, modes, speeds, frictions[i])
 
 
 @njit(cache=True)
@@ -398,17 +469,23 @@ def switch_mode(system, dynamics, projection, k, kind, t, y, modes, speeds, epis
 
 @njit(cache=True, inline="always")
 def consistent_modes(system, dynamics, projection, mode_switch, t, y, modes, speeds, episode_of, real, ints, log_joint,
-                     log_onset, log_loss, log_speed, log_mass):
-    """Switch joints whose mode disagrees with the state at the step start (initial state, restarts)."""
+                     log_onset, log_loss, log_speed, log_mass, frictions):
+    """Switch joints whose mode disagrees with the state at the step start (initial state, restarts); frictions: room
+    for the sticking joints' F_t (stick_frictions), solved once for all of them until a switch changes the state."""
     h = np.inf
+    solved = False
     for k in range(modes.shape[0]):
         for kind in range(2):
             if kind == TANGENTIAL and (modes[k] == FREE or not exact_stick(system, k)):
                 continue
-            g = event_value(system, dynamics, k, kind, t, y, modes, speeds)[0]
+            if needs_stick_solve(system, k, kind, modes) and not solved:
+                stick_frictions(system, dynamics, t, y, modes, speeds, frictions)
+                solved = True
+            g = event_value(system, dynamics, k, kind, t, y, modes, speeds, frictions[k])[0]
             if g > 0.0 if (kind == NORMAL and modes[k] == FREE) else g < 0.0:
                 h = min(h, mode_switch(system, dynamics, projection, k, kind, t, y, modes, speeds, episode_of, real,
                                        ints, log_joint, log_onset, log_loss, log_speed, log_mass))
+                solved = False  # the switch changed the modes, and may have projected y
     return h
 
 
@@ -437,7 +514,7 @@ def normal_force(system, k, state, modes, speeds):
 @njit(cache=True)
 def normal_force_at(system, k, y, stages, h, theta, modes, speeds, scratch):
     """F_n of joint k at t + θh on the step's continuous extension."""
-    interpolate(y, stages, h, theta, scratch)
+    interpolate_joint(system, k, y, stages, h, theta, scratch)
     return normal_force(system, k, scratch, modes, speeds)
 
 
@@ -570,7 +647,7 @@ def refine_event(system, dynamics, projection, implicit_step, k, kind, t, y, f, 
         projection(system, t + h_event, y_event, modes)
         if kind == TANGENTIAL:
             break
-        g, rate = event_value(system, dynamics, k, kind, t + h_event, y_event, modes, speeds)
+        g, rate = event_value(system, dynamics, k, kind, t + h_event, y_event, modes, speeds, UNSOLVED)
         if abs(g) <= tolerance or rate == 0.0:
             break
         h_event = min(max(h_event - g / rate, 0.5 * h_event), 2.0 * h_event)
@@ -588,6 +665,7 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
     y_new = np.empty_like(y)
     scratch = np.empty_like(y)
     points = np.empty((SUBDIVISIONS + 1, y.shape[0]))
+    frictions = np.zeros((SUBDIVISIONS + 1, modes.shape[0]))
     ints[I_STATUS] = RUNNING
     capacity = out_t.shape[0]
     attempts = 0
@@ -614,7 +692,7 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
             ints[I_STATUS] = BUFFER_FULL
             return
         switched = consistent_modes(system, dynamics, projection, mode_switch, t, y, modes, speeds, episode_of, real,
-                                    ints, log_joint, log_onset, log_loss, log_speed, log_mass)
+                                    ints, log_joint, log_onset, log_loss, log_speed, log_mass, frictions[0])
         if switched < np.inf or ints[I_NEXT_SAMPLE] == 0:
             rhs(system, dynamics, t, y, modes, speeds, f)
             ints[I_RHS] += 1
@@ -651,8 +729,8 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
         ints[I_JACOBIAN_AGE] += 1
         ints[I_RHS] += extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints)
         fill_subdivisions(y, stages, h, points)
-        event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, points, modes,
-                                                              speeds, scratch)
+        event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, points,
+                                                              frictions, modes, speeds, scratch)
         if event_joint >= 0:
             h = refine_event(system, dynamics, projection, implicit_step, event_joint, event_kind, t, y, f,
                              event_theta * h, modes, speeds, stages, y_new, real, ints, jacobian, jacobian_modes)

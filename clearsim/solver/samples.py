@@ -10,7 +10,7 @@ from numba import njit
 from clearsim.assembly.arrays import CL_CLEARANCE, CL_VISCOSITY, copy_into
 from clearsim.assembly.constraints import constraint_count
 from clearsim.assembly.dynamics import (
-    constraint_violation, coordinate_count, element_states, stick_row_index,
+    constraint_violation, coordinate_count, element_states,
 )
 from clearsim.assembly.forces import FREE, STICK, clearance_kinematics, contact_force_magnitudes, potential_energy
 
@@ -33,11 +33,13 @@ def derive_sample(system, dynamics, films, t, state, modes, speeds, qdd, lam, co
     accelerations, multipliers = dynamics(system, t, q, qd, element_states(system, state).copy(), modes, speeds)[:2]
     copy_into(qdd, accelerations)
     copy_into(lam, multipliers[:m])
+    stick_row = m  # the next sticking joint's row (dynamics.stick_row_index, counted along)
     for k in range(system.clearance_bodies.shape[0]):
         ex, ey, _, _, penetration, rate, _, _, sliding = clearance_kinematics(system, k, q, qd)
         fn, ft, _ = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], speeds[k])
         if modes[k] == STICK:
-            ft = -multipliers[stick_row_index(system, modes, k)]
+            ft = -multipliers[stick_row]
+            stick_row += 1
         fields = contact[k]
         fields[C_ECC_X], fields[C_ECC_Y], fields[C_PENETRATION], fields[C_RATE] = ex, ey, penetration, rate
         fields[C_NORMAL], fields[C_FRICTION], fields[C_SLIDING] = fn, ft, sliding

@@ -116,8 +116,8 @@ KIND_TITLES = {"clearance": "clearance", "friction": "friction", "stiffness": "c
                "compliance": "axial compliance", "beam_stiffness": "bending stiffness",
                "contact_length": "pin contact length", "port_area": "port area", "precharge": "accumulator precharge",
                "bulk_modulus": "oil bulk modulus", "preload": "spring preload", "dashpot": "dashpot",
-               "gas_load": "gas load", "guide_friction": "guide friction", "wear": "wear"}
-JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution", "contact_length", "wear"}
+               "gas_load": "gas load", "guide_friction": "guide friction", "wear": "wear", "viscosity": "oil viscosity"}
+JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution", "contact_length", "wear", "viscosity"}
 PARAMETER_NAMED = {"drive", "port_area", "dashpot"}  # kinds with several parameters per target: the label names it
 
 
@@ -258,6 +258,26 @@ def contact_length(mechanism, document) -> list[Candidate]:
 def restitution(mechanism, document) -> list[Candidate]:
     """Coefficient of restitution c_e of each clearance joint, 0.3 … 1."""
     return _contact_candidates(mechanism, "restitution", "restitution", "", lambda c0: (0.3, 1.0), False)
+
+
+VISCOSITY_FACTORS = (0.1, 10.0)  # a thinner oil (hot, a lighter grade) to a thicker one (cold, aged, a heavier grade)
+
+
+def viscosity(mechanism, document) -> list[Candidate]:
+    """Dynamic viscosity μ of each lubricated clearance joint's oil film (`lubrication.viscosity`, written on the joint:
+    it merges over `defaults.lubrication`), 0.1 … 10 times its present value."""
+    out = []
+    for joint in _clearance_joints(mechanism):
+        present = resolve_clearance(joint, mechanism.defaults).viscosity
+        if not present > 0.0:
+            continue
+
+        def write(doc, value, name=joint.name):
+            _set(doc, f"joints.{name}.lubrication.viscosity", si_text(value, "viscosity"))
+
+        out.append(Candidate("viscosity", joint.name, "viscosity", "Pa*s", VISCOSITY_FACTORS[0] * present,
+                             VISCOSITY_FACTORS[1] * present, True, present, write, ("mPa·s", 1e-3)))
+    return out
 
 
 WEAR_DEPTH_BOUNDS = (2e-6, 0.5e-3)  # m: peak depth d of a worn arc, 2 µm to 0.5 mm
@@ -551,7 +571,8 @@ KINDS: dict[str, Callable] = {"clearance": clearance, "friction": friction, "sti
                               "compliance": compliance, "beam_stiffness": beam_stiffness,
                               "contact_length": contact_length, "port_area": port_area, "precharge": precharge,
                               "bulk_modulus": bulk_modulus, "preload": preload, "dashpot": dashpot,
-                              "gas_load": gas_load, "guide_friction": guide_friction, "wear": wear}
+                              "gas_load": gas_load, "guide_friction": guide_friction, "wear": wear,
+                              "viscosity": viscosity}
 
 
 def candidates_for(mechanism, document: dict, kinds: list[str], base_dir: Path | str = ".") -> list[Candidate]:

@@ -5,15 +5,17 @@ The diagnosed mechanism: the journal of tests/validation/test_lubricated_joint.p
 short-bearing film of 50 mPa·s, 966 N, 2000 rad/s) started centred, with two proximity probes; the first 10 ms (it
 settles within 2 ms), `solver.method: rosenbrock` (the film's squeeze damping is stiff: docs/model-contact.md)."""
 
+import inspect
 import json
+import re
 from pathlib import Path
 
 import pytest
 import yaml
 from typer.testing import CliRunner
 
-from clearsim.cli import app
-from clearsim.diagnose.candidates import VISCOSITY_FACTORS, candidates_for
+from clearsim.cli import app, diagnose
+from clearsim.diagnose.candidates import KINDS, VISCOSITY_FACTORS, candidates_for
 from clearsim.diagnose.evaluate import document_text
 from clearsim.model.loader import load_mechanism, load_mechanism_text
 from clearsim.model.resolve import is_clearance_joint, resolve_clearance
@@ -102,3 +104,9 @@ def test_a_hidden_thinner_oil_is_named_at_its_joint_and_its_interval_holds_it(tm
     low, high = effect["interval"]["viscosity"]
     assert low <= HIDDEN <= high
     assert found["unexplained"] is False
+
+
+def test_the_candidates_option_names_every_kind():
+    """`diagnose --help` lists the kinds `--candidates` takes: every kind registered, viscosity included."""
+    listed = inspect.signature(diagnose).parameters["candidates"].default.help
+    assert set(KINDS) - set(re.findall(r"[a-z_]+", listed)) == set()

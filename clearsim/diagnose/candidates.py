@@ -241,17 +241,26 @@ CONTACT_LENGTH_FACTORS = (0.25, 4.0)  # a pin bearing on a quarter of its length
 def contact_length(mechanism, document) -> list[Candidate]:
     """Axial length L of the pin in its bore, for each clearance joint with a cylindrical elastic law (the contact's
     stiffness grows with it), ¼ … 4 times its present value."""
+    return _scaled_joint_candidates(
+        mechanism, "contact_length", "contact.length", "length", CONTACT_LENGTH_FACTORS, ("mm", 1e-3),
+        lambda joint: resolve_clearance(joint, mechanism.defaults).length if _cylindrical(mechanism, joint) else None)
+
+
+def _scaled_joint_candidates(mechanism, kind: str, path: str, dimension: str, factors: tuple[float, float],
+                             display_unit: tuple[str, float], present: Callable) -> list[Candidate]:
+    """One candidate per clearance joint whose `present` value (joint → value, or None) is above 0, for the key `path`
+    under the joint, in SI units of `dimension`, from factors[0] to factors[1] times its present value (log)."""
     out = []
     for joint in _clearance_joints(mechanism):
-        present = resolve_clearance(joint, mechanism.defaults).length
-        if not _cylindrical(mechanism, joint) or not present > 0.0:
+        value_now = present(joint)
+        if value_now is None or not value_now > 0.0:
             continue
 
         def write(doc, value, name=joint.name):
-            _set(doc, f"joints.{name}.contact.length", si_text(value, "length"))
+            _set(doc, f"joints.{name}.{path}", si_text(value, dimension))
 
-        out.append(Candidate("contact_length", joint.name, "length", "m", CONTACT_LENGTH_FACTORS[0] * present,
-                             CONTACT_LENGTH_FACTORS[1] * present, True, present, write, ("mm", 1e-3)))
+        out.append(Candidate(kind, joint.name, path.rsplit(".", 1)[-1], DIMENSIONS[dimension].si_unit,
+                             factors[0] * value_now, factors[1] * value_now, True, value_now, write, display_unit))
     return out
 
 
@@ -266,18 +275,8 @@ VISCOSITY_FACTORS = (0.1, 10.0)  # a thinner oil (hot, a lighter grade) to a thi
 def viscosity(mechanism, document) -> list[Candidate]:
     """Dynamic viscosity μ of each lubricated clearance joint's oil film (`lubrication.viscosity`, written on the joint:
     it merges over `defaults.lubrication`), 0.1 … 10 times its present value."""
-    out = []
-    for joint in _clearance_joints(mechanism):
-        present = resolve_clearance(joint, mechanism.defaults).viscosity
-        if not present > 0.0:
-            continue
-
-        def write(doc, value, name=joint.name):
-            _set(doc, f"joints.{name}.lubrication.viscosity", si_text(value, "viscosity"))
-
-        out.append(Candidate("viscosity", joint.name, "viscosity", "Pa*s", VISCOSITY_FACTORS[0] * present,
-                             VISCOSITY_FACTORS[1] * present, True, present, write, ("mPa·s", 1e-3)))
-    return out
+    return _scaled_joint_candidates(mechanism, "viscosity", "lubrication.viscosity", "viscosity", VISCOSITY_FACTORS,
+                                    ("mPa·s", 1e-3), lambda joint: resolve_clearance(joint, mechanism.defaults).viscosity)
 
 
 WEAR_DEPTH_BOUNDS = (2e-6, 0.5e-3)  # m: peak depth d of a worn arc, 2 µm to 0.5 mm

@@ -116,8 +116,8 @@ KIND_TITLES = {"clearance": "clearance", "friction": "friction", "stiffness": "c
                "compliance": "axial compliance", "beam_stiffness": "bending stiffness",
                "contact_length": "pin contact length", "port_area": "port area", "precharge": "accumulator precharge",
                "bulk_modulus": "oil bulk modulus", "preload": "spring preload", "dashpot": "dashpot",
-               "gas_load": "gas load", "guide_friction": "guide friction", "wear": "wear"}
-JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution", "contact_length", "wear"}
+               "gas_load": "gas load", "guide_friction": "guide friction", "wear": "wear", "viscosity": "oil viscosity"}
+JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution", "contact_length", "wear", "viscosity"}
 PARAMETER_NAMED = {"drive", "port_area", "dashpot"}  # kinds with several parameters per target: the label names it
 
 
@@ -241,23 +241,42 @@ CONTACT_LENGTH_FACTORS = (0.25, 4.0)  # a pin bearing on a quarter of its length
 def contact_length(mechanism, document) -> list[Candidate]:
     """Axial length L of the pin in its bore, for each clearance joint with a cylindrical elastic law (the contact's
     stiffness grows with it), ¼ … 4 times its present value."""
+    return _scaled_joint_candidates(
+        mechanism, "contact_length", "contact.length", "length", CONTACT_LENGTH_FACTORS, ("mm", 1e-3),
+        lambda joint: resolve_clearance(joint, mechanism.defaults).length if _cylindrical(mechanism, joint) else None)
+
+
+def _scaled_joint_candidates(mechanism, kind: str, path: str, dimension: str, factors: tuple[float, float],
+                             display_unit: tuple[str, float], present: Callable) -> list[Candidate]:
+    """One candidate per clearance joint whose `present` value (joint → value, or None) is above 0, for the key `path`
+    under the joint, in SI units of `dimension`, from factors[0] to factors[1] times its present value (log)."""
     out = []
     for joint in _clearance_joints(mechanism):
-        present = resolve_clearance(joint, mechanism.defaults).length
-        if not _cylindrical(mechanism, joint) or not present > 0.0:
+        value_now = present(joint)
+        if value_now is None or not value_now > 0.0:
             continue
 
         def write(doc, value, name=joint.name):
-            _set(doc, f"joints.{name}.contact.length", si_text(value, "length"))
+            _set(doc, f"joints.{name}.{path}", si_text(value, dimension))
 
-        out.append(Candidate("contact_length", joint.name, "length", "m", CONTACT_LENGTH_FACTORS[0] * present,
-                             CONTACT_LENGTH_FACTORS[1] * present, True, present, write, ("mm", 1e-3)))
+        out.append(Candidate(kind, joint.name, path.rsplit(".", 1)[-1], DIMENSIONS[dimension].si_unit,
+                             factors[0] * value_now, factors[1] * value_now, True, value_now, write, display_unit))
     return out
 
 
 def restitution(mechanism, document) -> list[Candidate]:
     """Coefficient of restitution c_e of each clearance joint, 0.3 … 1."""
     return _contact_candidates(mechanism, "restitution", "restitution", "", lambda c0: (0.3, 1.0), False)
+
+
+VISCOSITY_FACTORS = (0.1, 10.0)  # a thinner oil (hot, a lighter grade) to a thicker one (cold, aged, a heavier grade)
+
+
+def viscosity(mechanism, document) -> list[Candidate]:
+    """Dynamic viscosity μ of each lubricated clearance joint's oil film (`lubrication.viscosity`, written on the joint:
+    it merges over `defaults.lubrication`), 0.1 … 10 times its present value."""
+    return _scaled_joint_candidates(mechanism, "viscosity", "lubrication.viscosity", "viscosity", VISCOSITY_FACTORS,
+                                    ("mPa·s", 1e-3), lambda joint: resolve_clearance(joint, mechanism.defaults).viscosity)
 
 
 WEAR_DEPTH_BOUNDS = (2e-6, 0.5e-3)  # m: peak depth d of a worn arc, 2 µm to 0.5 mm
@@ -551,7 +570,8 @@ KINDS: dict[str, Callable] = {"clearance": clearance, "friction": friction, "sti
                               "compliance": compliance, "beam_stiffness": beam_stiffness,
                               "contact_length": contact_length, "port_area": port_area, "precharge": precharge,
                               "bulk_modulus": bulk_modulus, "preload": preload, "dashpot": dashpot,
-                              "gas_load": gas_load, "guide_friction": guide_friction, "wear": wear}
+                              "gas_load": gas_load, "guide_friction": guide_friction, "wear": wear,
+                              "viscosity": viscosity}
 
 
 def candidates_for(mechanism, document: dict, kinds: list[str], base_dir: Path | str = ".") -> list[Candidate]:

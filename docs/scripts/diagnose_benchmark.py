@@ -162,6 +162,10 @@ CASES = [
     # the flexible UHV breaker: a beam's bending stiffness
     Case("flexible-beam-low", FLEXIBLE, FRICTIONLESS_UHV, UHV_CONTACT, low, "beam_stiffness,drive",
          ("beam_stiffness", "lower_turn_arm", "E·I factor", 0.62)),
+    # the slider-crank with its slider pin in an oil film (20 mPa·s, 9 mm short bearing): a thinner oil
+    Case("crank-viscosity-mid", SLIDER_CRANK, ["joints.slider_pin.lubrication={viscosity: 20 mPa*s, length: 9 mm}",
+                                               "solver.method=rosenbrock"], CRANK_BENCH, mid, "viscosity,clearance,mass",
+         ("viscosity", "slider_pin", "viscosity", 0.012)),
 ]
 QUICK = ["crank-clearance-low", "crank-null-low", "crank-force-mid", "block-preload-low"]
 

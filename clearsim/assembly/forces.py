@@ -20,8 +20,8 @@ from numba import njit
 from clearsim.assembly.arrays import (
     CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_POINT,
     CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_RESTITUTION, CL_STIFFNESS,
-    CL_V_HIGH, CL_V_LOW, CL_DRY_GAP, CL_FILM_LENGTH, CL_VISCOSITY, LAW_FILM_MODEL, WEAR_LINE_STIFFNESS, WEAR_SCALE,
-    WEAR_SLOT, WEAR_SLOT_HARMONICS, WEAR_WEIGHTS,
+    CL_V_HIGH, CL_V_LOW, CL_DRY_GAP, CL_FILM_LENGTH, CL_VISCOSITY, LAW_FILM_MODEL, WEAR_INNERMOST, WEAR_LINE_STIFFNESS,
+    WEAR_REACH, WEAR_SCALE, WEAR_SLOT, WEAR_SLOT_HARMONICS, WEAR_WEIGHTS,
 )
 from clearsim.assembly.kinematics import (
     GROUND, add_global_force, add_point_force, body_pose, body_rates, frame_point, frame_rotate, frame_velocity,
@@ -84,8 +84,8 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
     c, s = np.cos(angle), np.sin(angle)
     local_x, local_y = c * ex + s * ey, -s * ex + c * ey
     _, rx, ry, tangent_x, tangent_y, curvature = nearest_bore_point(
-        system.wear_profile[k], system.wear_harmonics[k], system.wear_depth_range[k], system.wear_reach[k],
-        p[CL_BEARING_RADIUS], local_x, local_y)
+        system.wear_profile[k], system.wear_harmonics[k], system.wear_depth_range[k], system.wear_bounds[k, WEAR_REACH],
+        system.wear_bounds[k, WEAR_INNERMOST], p[CL_BEARING_RADIUS], local_x, local_y)
     gap_x, gap_y = rx - local_x, ry - local_y
     distance = np.sqrt(gap_x * gap_x + gap_y * gap_y)
     local_nx, local_ny = gap_x / distance, gap_y / distance

@@ -26,8 +26,11 @@ import math
 import numpy as np
 from numba import njit
 
-SAFEGUARDED_ITERATIONS = 60  # Newton converges quadratically (a step below 1e-15 rad ends it); a bisection step, taken
-# when Newton would leave its bracket of 2π/(8M) either side, halves it
+SAFEGUARDED_ITERATIONS = 60  # Newton converges quadratically (a step below NEWTON_TOLERANCE ends it); a bisection
+# step, taken when Newton would leave its bracket of 2π/(8M) either side, halves it (one below 1e-15 rad ends it)
+NEWTON_TOLERANCE = 1e-12  # rad: the point after such a step is off by ~(g''/2g') 1e-24 plus the round-off of g, which
+# makes the steps jitter at ~ε R_B/|e| (5e-13 rad in a 0.01 mm joint of R_B = 50 mm): a smaller one is never reached
+WALK_SPACINGS = 4  # the longest step towards a minimum before its bracket, in sample spacings 2π/(8M)
 SMALLEST_SIGMA = 4.0  # σ ≥ 4/M: the truncated kernel's last weight is e^{-8} = 3e-4 of the first (no ringing)
 CONFORMAL_HALF_ANGLE = 0.5 * math.pi  # rad: a journal touches its bore within 90° of the load, however conformal
 
@@ -81,20 +84,41 @@ def _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, theta):
 
 
 @njit(cache=True)
-def nearest_bore_point(coefficients, harmonics, depth_range, reach, bearing_radius, ex, ey):
-    """closest_bore_point, without its search where the nearest point is certain: a point inside the bore nearer to it
-    than its inner reach (inner_reach) lies on the inward normal of exactly one bore point, which is its nearest, so a
-    minimum of the distance found by Newton's method from the angle of e (descended_foot) is the nearest point when
-    its distance is below the reach — always in contact (the distance ≈ R_J) on a bore nowhere tighter than the
-    journal. Only otherwise (e far from the wall, or a bore worn tighter than the journal somewhere, whose distance
-    has several local minima: a two-point contact) is the nearest point searched for (closest_bore_point)."""
-    start = math.atan2(ey, ex) if math.sqrt(ex * ex + ey * ey) > 0.0 else 0.0
+def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing_radius, ex, ey):
+    """closest_bore_point, searching only where the nearest point is not certain. A point inside the bore nearer to it
+    than its inner reach (inner_reach) lies on the inward normal of exactly one bore point, which is its nearest, so
+    the minimum of the distance Newton's method finds from the angle of e (descended_foot) is the nearest point when
+    its distance d is below the reach — always in contact (d ≈ R_J) on a bore nowhere tighter than the journal.
+    Otherwise (e far from the wall, or a bore worn tighter than the journal somewhere, whose distance has several local
+    minima: a two-point contact) a nearer point can only lie where ρ_min − |e| cos φ < d (φ = θ − θ_e; |r(θ) − e| ≥
+    ρ(θ) − |e| cos φ, ρ_min ≤ ρ = `innermost`), which narrows search_window's window; that is searched as
+    closest_bore_point does (searched_foot), and the nearer of its point and Newton's kept."""
+    eccentricity = math.sqrt(ex * ex + ey * ey)
+    start = math.atan2(ey, ex) if eccentricity > 0.0 else 0.0
     spacing = 2.0 * math.pi / (8.0 * max(harmonics, 1))
-    theta, found = descended_foot(coefficients, harmonics, reach, bearing_radius, ex, ey, start, spacing)
-    if not found:
-        return closest_bore_point(coefficients, harmonics, depth_range, bearing_radius, ex, ey)
+    theta, distance = descended_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing)
+    window = search_window(eccentricity, depth_range)
+    if distance < reach:
+        window = 0.0
+    elif distance < math.inf:
+        window = min(window, nearer_window(eccentricity, innermost, distance))
+    if window > 0.0:
+        searched = searched_foot(coefficients, harmonics, window, bearing_radius, ex, ey, start, spacing)
+        if not distance <= math.sqrt(_distance_squared(coefficients, harmonics, bearing_radius, ex, ey, searched)):
+            theta = searched
     rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
     return theta, rx, ry, tx, ty, second
+
+
+@njit(cache=True)
+def nearer_window(eccentricity, innermost, distance):
+    """Half-width (rad) round the angle of e outside which no bore point is nearer to e than `distance`:
+    ρ_min − |e| cos φ ≥ d there (0: none anywhere; π: the whole bore)."""
+    if innermost - distance >= eccentricity:
+        return 0.0
+    if innermost - distance <= -eccentricity:
+        return math.pi
+    return math.acos((innermost - distance) / eccentricity)
 
 
 @njit(cache=True)
@@ -104,48 +128,49 @@ def closest_bore_point(coefficients, harmonics, depth_range, bearing_radius, ex,
 
     The global minimum: a bore worn tighter than the journal's curvature somewhere has several local minima of the
     distance (a two-point contact) with a maximum between them, and Newton's method from the angle of e may stop on
-    either: searched_foot samples the window where a nearer point can lie."""
+    either: searched_foot samples the window of search_window, where a nearer point can lie."""
     eccentricity = math.sqrt(ex * ex + ey * ey)
     start = math.atan2(ey, ex) if eccentricity > 0.0 else 0.0
     spacing = 2.0 * math.pi / (8.0 * max(harmonics, 1))
-    theta = searched_foot(coefficients, harmonics, depth_range, bearing_radius, ex, ey, start, spacing)
+    theta = searched_foot(coefficients, harmonics, search_window(eccentricity, depth_range), bearing_radius, ex, ey,
+                          start, spacing)
     rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
     return theta, rx, ry, tx, ty, second
 
 
 @njit(cache=True)
-def descended_foot(coefficients, harmonics, reach, bearing_radius, ex, ey, start, spacing):
-    """(θ, found): Newton's method on g = (r − e)·r' = 0 from `start`, each step at most `spacing` (downhill by
-    `spacing` where g' ≤ 0); once a full step is shorter than that, refined_foot from where it leads (twice at most:
-    again from where the first stopped, if the minimum was beyond its bracket). Found when that converges to a minimum
-    whose distance is below the reach with e on the bore's inward side, which makes it the global minimum
-    (nearest_bore_point)."""
+def descended_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing):
+    """(θ, d): Newton's method on g = (r − e)·r' = 0 from `start`, each step at most WALK_SPACINGS `spacing` (downhill
+    by that where g' ≤ 0); once a full step is shorter than that, refined_foot from where it leads (twice at most: again from
+    where the first stopped, if the minimum was beyond its bracket). d = |r(θ) − e| where that converges to a minimum
+    with e on the bore's inward side, inf where it does not."""
     theta = start
     refinements = 0
+    longest = WALK_SPACINGS * spacing
     for _ in range(SAFEGUARDED_ITERATIONS):
         rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
-        if second > 0.0 and abs(gradient) < spacing * second:
+        if second > 0.0 and abs(gradient) < longest * second:
             theta, converged = refined_foot(coefficients, harmonics, bearing_radius, ex, ey, theta - gradient / second,
                                             spacing)
             refinements += 1
             if converged:
                 rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
                 dx, dy = ex - rx, ey - ry
-                inward = dy * tx - dx * ty > 0.0  # e − r along the inward normal (−r'_y, r'_x)
-                return theta, second > 0.0 and inward and dx * dx + dy * dy < reach * reach
+                if second > 0.0 and dy * tx - dx * ty > 0.0:  # e − r along the inward normal (−r'_y, r'_x)
+                    return theta, math.sqrt(dx * dx + dy * dy)
+                return theta, math.inf
             if refinements == 2:
                 break
         else:
-            theta += -spacing if gradient > 0.0 else spacing
-    return theta, False
+            theta += -longest if gradient > 0.0 else longest
+    return theta, math.inf
 
 
 @njit(cache=True)
-def searched_foot(coefficients, harmonics, depth_range, bearing_radius, ex, ey, start, spacing):
-    """θ of the global minimum of the distance from e: samples every `spacing` over the window of search_window round
-    the angle `start` of e (none for a profile without range) pick the nearest, refined_foot refines it."""
+def searched_foot(coefficients, harmonics, window, bearing_radius, ex, ey, start, spacing):
+    """θ of the nearest point to e within `window` of the angle `start` of e: samples every `spacing` over the window
+    (none for a window 0) pick the nearest, refined_foot refines it."""
     theta = start
-    window = search_window(math.sqrt(ex * ex + ey * ey), depth_range)
     if window > 0.0:
         samples = int(math.ceil(window / spacing))
         best, nearest = theta, _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, theta)
@@ -163,8 +188,8 @@ def refined_foot(coefficients, harmonics, bearing_radius, ex, ey, theta, spacing
     """(θ, converged): Newton's method on g = (r − e)·r' = 0 from θ inside a bracket of `spacing` either side, a step
     that would leave the bracket, or a point where g' ≤ 0, taking a bisection step of the bracket instead (g' ≤ 0
     everywhere near e: e far from the wall, near a centre of curvature, in free flight — the bisection then stops in
-    θ's neighbourhood); ends at a step below 1e-15 rad. Converged: at a Newton step below 1e-15 rad, or with g < 0
-    met below θ and g > 0 above (round-off in g makes the last Newton steps jitter: a minimum lies between them)."""
+    θ's neighbourhood); ends at a Newton step below NEWTON_TOLERANCE or a bisection step below 1e-15 rad. Converged:
+    at such a Newton step, or with g < 0 met below θ and g > 0 above (a minimum lies between them)."""
     low, high = theta - spacing, theta + spacing
     rising = falling = False
     for _ in range(SAFEGUARDED_ITERATIONS):
@@ -179,7 +204,7 @@ def refined_foot(coefficients, harmonics, bearing_radius, ex, ey, theta, spacing
         following = theta - gradient / second if newton else low - 1.0
         if not low <= following <= high:
             following, newton = 0.5 * (low + high), False
-        if abs(following - theta) < 1e-15:
+        if abs(following - theta) < (NEWTON_TOLERANCE if newton else 1e-15):
             return following, newton or (rising and falling and low <= following <= high)
         theta = following
     return theta, rising and falling and low <= theta <= high
@@ -331,13 +356,25 @@ def inner_reach(coefficients, bearing_radius: float) -> float:
             angles[i] - spacing, angles[i] + spacing))
     orders = np.arange(1, harmonics + 1)
     sizes = np.hypot(coefficients[1::2][:harmonics], coefficients[2::2][:harmonics])
-    depth = evaluate_profile(coefficients, angles)
     slopes = np.abs(sum(order * (coefficients[2 * order] * np.cos(order * angles)
                                  - coefficients[2 * order - 1] * np.sin(order * angles)) for order in orders))
-    smallest_radius = bearing_radius + depth.min() - float(np.sum(orders * sizes)) * spacing / 2.0
+    smallest_radius = innermost_radius(coefficients, bearing_radius)
     steepest = slopes.max() + float(np.sum(orders ** 2 * sizes)) * spacing / 2.0
     half_bottleneck = smallest_radius / math.hypot(1.0, steepest / smallest_radius)
     return min(tightest * (1.0 - REACH_MARGIN), half_bottleneck)
+
+
+def innermost_radius(coefficients, bearing_radius: float) -> float:
+    """A lower bound (m) of the bore's smallest radius ρ_min = R_B + min h: the least on 64 M angles, less the most
+    the series can move between two of them (Σ m √(a_m² + b_m²) times half their spacing)."""
+    coefficients = np.asarray(coefficients, float)
+    harmonics = (coefficients.shape[0] - 1) // 2
+    if harmonics <= 0:
+        return float(bearing_radius + (coefficients[0] if coefficients.shape[0] else 0.0))
+    angles = np.linspace(0.0, 2.0 * math.pi, 64 * harmonics, endpoint=False)
+    orders = np.arange(1, harmonics + 1)
+    slope_bound = float(np.sum(orders * np.hypot(coefficients[1::2][:harmonics], coefficients[2::2][:harmonics])))
+    return bearing_radius + float(evaluate_profile(coefficients, angles).min()) - slope_bound * (angles[1] - angles[0]) / 2.0
 
 
 def _golden_minimum(function, low: float, high: float) -> float:

@@ -329,8 +329,8 @@ def inner_reach(coefficients, bearing_radius: float) -> float:
     that has one nearest bore point, the foot of the only inward normal through it, so a minimum of the distance
     found there by Newton's method is the global one (nearest_bore_point). The inner medial axis comes nearest the
     bore at a centre of curvature or at the middle of a bottleneck, a chord inside the bore along the normals at
-    both its ends (Federer 1959, Curvature measures, Thm 4.18; Aamari et al. 2019, Estimating the reach of a manifold,
-    Thm 3.4), so the reach is the lesser of
+    both its ends (Federer 1959, Curvature measures, Thm 4.8; Aamari et al. 2019, Estimating the reach of a
+    manifold), so the reach is the lesser of
 
     - the tightest radius of curvature on the inner side (bore_curvature_radius): its local minima on 64 M angles,
       each refined by golden sections between its neighbours (32 angles to the shortest period of the bending

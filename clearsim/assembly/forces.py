@@ -106,14 +106,16 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
 
 
 @njit(cache=True)
-def bearing_contact_arm(system, k, q, qd, kinematics):
+def bearing_contact_arm(system, k, kinematics):
     """The bearing's contact point relative to its centre P_B (global), from the joint's clearance_kinematics: R_B n
-    on a circular bore."""
-    ex, ey, dex, dey, _, _, nx, ny, _ = kinematics
+    on a circular bore; on a worn bore its point r nearest to the journal's centre, e + |r − e| n with
+    |r − e| = R_J − δ (worn_contact's, without finding r again)."""
+    ex, ey, _, _, penetration, _, nx, ny, _ = kinematics
+    p = system.clearance_params[k]
     if system.wear_harmonics[k] > 0:
-        return worn_contact(system, k, q, qd, ex, ey, dex, dey)[5:7]
-    radius = system.clearance_params[k, CL_BEARING_RADIUS]
-    return radius * nx, radius * ny
+        distance = p[CL_JOURNAL_RADIUS] - (penetration - p[CL_DRY_GAP])
+        return ex + distance * nx, ey + distance * ny
+    return p[CL_BEARING_RADIUS] * nx, p[CL_BEARING_RADIUS] * ny
 
 
 @njit(cache=True)
@@ -201,7 +203,7 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized, with_
         bx, by = frame_point(kept_frame(system, q, bearing), p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
         add_global_force(generalized, q, journal, bx + ex + p[CL_JOURNAL_RADIUS] * nx,
                          by + ey + p[CL_JOURNAL_RADIUS] * ny, fx, fy)
-        arm_x, arm_y = bearing_contact_arm(system, k, q, qd, kinematics)
+        arm_x, arm_y = bearing_contact_arm(system, k, kinematics)
         add_global_force(generalized, q, bearing, bx + arm_x, by + arm_y, -fx, -fy)
         friction_loss -= ft * sliding
     return contact_loss, friction_loss
@@ -227,7 +229,7 @@ def add_wear_rates(system, q, qd, modes, impact_speeds, zdot):
         fn = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], impact_speeds[k])[0]
         if fn == 0.0:
             continue
-        arm_x, arm_y = bearing_contact_arm(system, k, q, qd, kinematics)
+        arm_x, arm_y = bearing_contact_arm(system, k, kinematics)
         contact_angle = np.arctan2(arm_y, arm_x) - body_pose(q, system.clearance_bodies[k, 0])[2]
         add_band_rates(rates, system.wear_rates[k, WEAR_WEIGHTS:], harmonics,
                        system.wear_rates[k, WEAR_SCALE] * fn * abs(sliding), contact_angle,

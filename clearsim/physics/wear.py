@@ -110,7 +110,7 @@ def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, b
     return theta, rx, ry, tx, ty, second
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def nearer_window(eccentricity, innermost, distance):
     """Half-width (rad) round the angle of e outside which no bore point is nearer to e than `distance`:
     ρ_min − |e| cos φ ≥ d there (0: none anywhere; π: the whole bore)."""
@@ -138,7 +138,7 @@ def closest_bore_point(coefficients, harmonics, depth_range, bearing_radius, ex,
     return theta, rx, ry, tx, ty, second
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def descended_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing):
     """(θ, d): Newton's method on g = (r − e)·r' = 0 from `start`, each step at most WALK_SPACINGS `spacing` (downhill
     by that where g' ≤ 0); once a full step is shorter than that, refined_foot from where it leads (twice at most: again from
@@ -166,7 +166,7 @@ def descended_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spaci
     return theta, math.inf
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def searched_foot(coefficients, harmonics, window, bearing_radius, ex, ey, start, spacing):
     """θ of the nearest point to e within `window` of the angle `start` of e: samples every `spacing` over the window
     (none for a window 0) pick the nearest, refined_foot refines it."""

@@ -325,6 +325,9 @@ def wear_arrays(parameters: list[ClearanceParameters], first_slot: int) -> dict:
                                                                                              p.archard.harmonics)
     return {"wear_harmonics": np.array([(len(p.wear_profile) - 1) // 2 for p in parameters], np.int64).reshape(count),
             "wear_profile": profile, "wear_depth_range": np.array([wear.depth_range(p.wear_profile) for p in parameters]),
+            "wear_bounds": np.array([(wear.inner_reach(p.wear_profile, p.bearing_radius),
+                                      wear.innermost_radius(p.wear_profile, p.bearing_radius)) for p in parameters]
+                                    ).reshape(count, 2),
             "wear_slots": slots, "wear_rates": rates}
 
 

@@ -20,8 +20,8 @@ from numba import njit
 from clearsim.assembly.arrays import (
     CL_BEARING_POINT, CL_BEARING_RADIUS, CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_POINT,
     CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_RESTITUTION, CL_STIFFNESS,
-    CL_V_HIGH, CL_V_LOW, CL_DRY_GAP, CL_FILM_LENGTH, CL_VISCOSITY, LAW_FILM_MODEL, WEAR_LINE_STIFFNESS, WEAR_SCALE,
-    WEAR_SLOT, WEAR_SLOT_HARMONICS, WEAR_WEIGHTS,
+    CL_V_HIGH, CL_V_LOW, CL_DRY_GAP, CL_FILM_LENGTH, CL_VISCOSITY, LAW_FILM_MODEL, WEAR_INNERMOST, WEAR_LINE_STIFFNESS,
+    WEAR_REACH, WEAR_SCALE, WEAR_SLOT, WEAR_SLOT_HARMONICS, WEAR_WEIGHTS,
 )
 from clearsim.assembly.kinematics import (
     GROUND, add_global_force, add_point_force, body_pose, body_rates, frame_point, frame_rotate, frame_velocity,
@@ -33,7 +33,7 @@ from clearsim.physics.contact import damped_force
 from clearsim.physics.cylindrical import law_force, law_state
 from clearsim.physics.friction import STICK_EXACT, friction_coefficient, sliding_coefficient
 from clearsim.physics.lubrication import film_force, film_torque, line_of_centres
-from clearsim.physics.wear import add_band_rates, band_half_angle, bore_curvature_radius, closest_bore_point
+from clearsim.physics.wear import add_band_rates, band_half_angle, bore_curvature_radius, nearest_bore_point
 
 # modes of a clearance joint, constant within a step. CONTACT is any contact of a smooth friction
 # law, and sliding along +t under an exact-stick law; STICK and SLIDE_BACK (sliding along −t)
@@ -83,9 +83,9 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
     wb = body_rates(qd, bearing)[2]
     c, s = np.cos(angle), np.sin(angle)
     local_x, local_y = c * ex + s * ey, -s * ex + c * ey
-    _, rx, ry, tangent_x, tangent_y, curvature = closest_bore_point(
-        system.wear_profile[k], system.wear_harmonics[k], system.wear_depth_range[k], p[CL_BEARING_RADIUS], local_x,
-        local_y)
+    _, rx, ry, tangent_x, tangent_y, curvature = nearest_bore_point(
+        system.wear_profile[k], system.wear_harmonics[k], system.wear_depth_range[k], system.wear_bounds[k, WEAR_REACH],
+        system.wear_bounds[k, WEAR_INNERMOST], p[CL_BEARING_RADIUS], local_x, local_y)
     gap_x, gap_y = rx - local_x, ry - local_y
     distance = np.sqrt(gap_x * gap_x + gap_y * gap_y)
     local_nx, local_ny = gap_x / distance, gap_y / distance
@@ -106,14 +106,16 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
 
 
 @njit(cache=True)
-def bearing_contact_arm(system, k, q, qd, kinematics):
+def bearing_contact_arm(system, k, kinematics):
     """The bearing's contact point relative to its centre P_B (global), from the joint's clearance_kinematics: R_B n
-    on a circular bore."""
-    ex, ey, dex, dey, _, _, nx, ny, _ = kinematics
+    on a circular bore; on a worn bore its point r nearest to the journal's centre, e + |r − e| n with
+    |r − e| = R_J − δ (worn_contact's, without finding r again)."""
+    ex, ey, _, _, penetration, _, nx, ny, _ = kinematics
+    p = system.clearance_params[k]
     if system.wear_harmonics[k] > 0:
-        return worn_contact(system, k, q, qd, ex, ey, dex, dey)[5:7]
-    radius = system.clearance_params[k, CL_BEARING_RADIUS]
-    return radius * nx, radius * ny
+        distance = p[CL_JOURNAL_RADIUS] - (penetration - p[CL_DRY_GAP])
+        return ex + distance * nx, ey + distance * ny
+    return p[CL_BEARING_RADIUS] * nx, p[CL_BEARING_RADIUS] * ny
 
 
 @njit(cache=True)
@@ -201,7 +203,7 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized, with_
         bx, by = frame_point(kept_frame(system, q, bearing), p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
         add_global_force(generalized, q, journal, bx + ex + p[CL_JOURNAL_RADIUS] * nx,
                          by + ey + p[CL_JOURNAL_RADIUS] * ny, fx, fy)
-        arm_x, arm_y = bearing_contact_arm(system, k, q, qd, kinematics)
+        arm_x, arm_y = bearing_contact_arm(system, k, kinematics)
         add_global_force(generalized, q, bearing, bx + arm_x, by + arm_y, -fx, -fy)
         friction_loss -= ft * sliding
     return contact_loss, friction_loss
@@ -227,7 +229,7 @@ def add_wear_rates(system, q, qd, modes, impact_speeds, zdot):
         fn = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], impact_speeds[k])[0]
         if fn == 0.0:
             continue
-        arm_x, arm_y = bearing_contact_arm(system, k, q, qd, kinematics)
+        arm_x, arm_y = bearing_contact_arm(system, k, kinematics)
         contact_angle = np.arctan2(arm_y, arm_x) - body_pose(q, system.clearance_bodies[k, 0])[2]
         add_band_rates(rates, system.wear_rates[k, WEAR_WEIGHTS:], harmonics,
                        system.wear_rates[k, WEAR_SCALE] * fn * abs(sliding), contact_angle,

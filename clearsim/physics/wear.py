@@ -6,7 +6,8 @@ A worn bore's wear depth over the angle θ in the bearing body's frame is a trun
 
 so the bore is the curve r(θ) = (R_B + h(θ)) u(θ), u = (cos θ, sin θ): C∞, periodic, with exact derivatives for its
 normal. The journal (radius R_J, centre e in the bearing frame) touches it at the bore point closest to e:
-θ* minimises |r(θ) − e|², found by Newton's method from the angle of e; the penetration is δ = R_J − |r(θ*) − e| and
+θ* minimises |r(θ) − e|², found by Newton's method from the angle of e (searched for only where that is not certain
+to be the global minimum: nearest_bore_point); the penetration is δ = R_J − |r(θ*) − e| and
 the contact normal n = (r(θ*) − e)/|r(θ*) − e| is the bore's local normal there (exact, not e/|e|).
 
 Archard's law gives the worn volume rate V̇ = k_w F_n |v_t| / H; it is spread over the bore with a periodic kernel
@@ -25,8 +26,11 @@ import math
 import numpy as np
 from numba import njit
 
-SAFEGUARDED_ITERATIONS = 60  # Newton converges quadratically (a step below 1e-15 rad ends it); a bisection step, taken
-# when Newton would leave its bracket of 2π/(8M) either side, halves it
+SAFEGUARDED_ITERATIONS = 60  # Newton converges quadratically (a step below NEWTON_TOLERANCE ends it); a bisection
+# step, taken when Newton would leave its bracket of 2π/(8M) either side, halves it (one below 1e-15 rad ends it)
+NEWTON_TOLERANCE = 1e-12  # rad: the point after such a step is off by ~(g''/2g') 1e-24 plus the round-off of g, which
+# makes the steps jitter at ~ε R_B/|e| (5e-13 rad in a 0.01 mm joint of R_B = 50 mm): a smaller one is never reached
+WALK_SPACINGS = 4  # the longest step towards a minimum before its bracket, in sample spacings 2π/(8M)
 SMALLEST_SIGMA = 4.0  # σ ≥ 4/M: the truncated kernel's last weight is e^{-8} = 3e-4 of the first (no ringing)
 CONFORMAL_HALF_ANGLE = 0.5 * math.pi  # rad: a journal touches its bore within 90° of the load, however conformal
 
@@ -80,21 +84,93 @@ def _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, theta):
 
 
 @njit(cache=True)
+def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing_radius, ex, ey):
+    """closest_bore_point, searching only where the nearest point is not certain. A point inside the bore nearer to it
+    than its inner reach (inner_reach) lies on the inward normal of exactly one bore point, which is its nearest, so
+    the minimum of the distance Newton's method finds from the angle of e (descended_foot) is the nearest point when
+    its distance d is below the reach — always in contact (d ≈ R_J) on a bore nowhere tighter than the journal.
+    Otherwise (e far from the wall, or a bore worn tighter than the journal somewhere, whose distance has several local
+    minima: a two-point contact) a nearer point can only lie where ρ_min − |e| cos φ < d (φ = θ − θ_e; |r(θ) − e| ≥
+    ρ(θ) − |e| cos φ, ρ_min ≤ ρ = `innermost`), which narrows search_window's window; that is searched as
+    closest_bore_point does (searched_foot), and the nearer of its point and Newton's kept."""
+    eccentricity = math.sqrt(ex * ex + ey * ey)
+    start = math.atan2(ey, ex) if eccentricity > 0.0 else 0.0
+    spacing = 2.0 * math.pi / (8.0 * max(harmonics, 1))
+    theta, distance = descended_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing)
+    window = search_window(eccentricity, depth_range)
+    if distance < reach:
+        window = 0.0
+    elif distance < math.inf:
+        window = min(window, nearer_window(eccentricity, innermost, distance))
+    if window > 0.0:
+        searched = searched_foot(coefficients, harmonics, window, bearing_radius, ex, ey, start, spacing)
+        if not distance <= math.sqrt(_distance_squared(coefficients, harmonics, bearing_radius, ex, ey, searched)):
+            theta = searched
+    rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
+    return theta, rx, ry, tx, ty, second
+
+
+@njit(cache=True, inline="always")
+def nearer_window(eccentricity, innermost, distance):
+    """Half-width (rad) round the angle of e outside which no bore point is nearer to e than `distance`:
+    ρ_min − |e| cos φ ≥ d there (0: none anywhere; π: the whole bore)."""
+    if innermost - distance >= eccentricity:
+        return 0.0
+    if innermost - distance <= -eccentricity:
+        return math.pi
+    return math.acos((innermost - distance) / eccentricity)
+
+
+@njit(cache=True)
 def closest_bore_point(coefficients, harmonics, depth_range, bearing_radius, ex, ey):
     """(θ*, r_x, r_y, r'_x, r'_y, g') of the bore point r(θ*) closest to e = (ex, ey), all in the bearing frame;
     g' = |r'|² + (r − e)·r'' is the curvature of |r(θ) − e|²/2 there (> 0 at a minimum; for the rate of θ*).
 
     The global minimum: a bore worn tighter than the journal's curvature somewhere has several local minima of the
     distance (a two-point contact) with a maximum between them, and Newton's method from the angle of e may stop on
-    either. Samples every 2π/(8M) over the window of search_window (none for a profile without range) pick the
-    nearest; Newton's method on g = (r − e)·r' = 0 refines it inside a bracket of one sample spacing either side,
-    a step that would leave the bracket, or a point where g' ≤ 0, taking a bisection step of the bracket instead
-    (g' ≤ 0 everywhere near e: e far from the wall, near a centre of curvature, in free flight — the bracket's
-    bisection then stops on its sampled nearest point's neighbourhood)."""
+    either: searched_foot samples the window of search_window, where a nearer point can lie."""
     eccentricity = math.sqrt(ex * ex + ey * ey)
-    theta = math.atan2(ey, ex) if eccentricity > 0.0 else 0.0
-    window = search_window(eccentricity, depth_range)
+    start = math.atan2(ey, ex) if eccentricity > 0.0 else 0.0
     spacing = 2.0 * math.pi / (8.0 * max(harmonics, 1))
+    theta = searched_foot(coefficients, harmonics, search_window(eccentricity, depth_range), bearing_radius, ex, ey,
+                          start, spacing)
+    rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
+    return theta, rx, ry, tx, ty, second
+
+
+@njit(cache=True, inline="always")
+def descended_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing):
+    """(θ, d): Newton's method on g = (r − e)·r' = 0 from `start`, each step at most WALK_SPACINGS `spacing` (downhill
+    by that where g' ≤ 0); once a full step is shorter than that, refined_foot from where it leads (twice at most: again from
+    where the first stopped, if the minimum was beyond its bracket). d = |r(θ) − e| where that converges to a minimum
+    with e on the bore's inward side, inf where it does not."""
+    theta = start
+    refinements = 0
+    longest = WALK_SPACINGS * spacing
+    for _ in range(SAFEGUARDED_ITERATIONS):
+        rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
+        if second > 0.0 and abs(gradient) < longest * second:
+            theta, converged = refined_foot(coefficients, harmonics, bearing_radius, ex, ey, theta - gradient / second,
+                                            spacing)
+            refinements += 1
+            if converged:
+                rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
+                dx, dy = ex - rx, ey - ry
+                if second > 0.0 and dy * tx - dx * ty > 0.0:  # e − r along the inward normal (−r'_y, r'_x)
+                    return theta, math.sqrt(dx * dx + dy * dy)
+                return theta, math.inf
+            if refinements == 2:
+                break
+        else:
+            theta += -longest if gradient > 0.0 else longest
+    return theta, math.inf
+
+
+@njit(cache=True, inline="always")
+def searched_foot(coefficients, harmonics, window, bearing_radius, ex, ey, start, spacing):
+    """θ of the nearest point to e within `window` of the angle `start` of e: samples every `spacing` over the window
+    (none for a window 0) pick the nearest, refined_foot refines it."""
+    theta = start
     if window > 0.0:
         samples = int(math.ceil(window / spacing))
         best, nearest = theta, _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, theta)
@@ -104,22 +180,34 @@ def closest_bore_point(coefficients, harmonics, depth_range, bearing_radius, ex,
             if distance < nearest:
                 best, nearest = candidate, distance
         theta = best
+    return refined_foot(coefficients, harmonics, bearing_radius, ex, ey, theta, spacing)[0]
+
+
+@njit(cache=True)
+def refined_foot(coefficients, harmonics, bearing_radius, ex, ey, theta, spacing):
+    """(θ, converged): Newton's method on g = (r − e)·r' = 0 from θ inside a bracket of `spacing` either side, a step
+    that would leave the bracket, or a point where g' ≤ 0, taking a bisection step of the bracket instead (g' ≤ 0
+    everywhere near e: e far from the wall, near a centre of curvature, in free flight — the bisection then stops in
+    θ's neighbourhood); ends at a Newton step below NEWTON_TOLERANCE or a bisection step below 1e-15 rad. Converged:
+    at such a Newton step, or with g < 0 met below θ and g > 0 above (a minimum lies between them)."""
     low, high = theta - spacing, theta + spacing
+    rising = falling = False
     for _ in range(SAFEGUARDED_ITERATIONS):
         rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
         if gradient > 0.0:
             high = min(high, theta)
+            rising = True
         elif gradient < 0.0:
             low = max(low, theta)
-        following = theta - gradient / second if second > 0.0 else low - 1.0
+            falling = True
+        newton = second > 0.0
+        following = theta - gradient / second if newton else low - 1.0
         if not low <= following <= high:
-            following = 0.5 * (low + high)
-        if abs(following - theta) < 1e-15:
-            theta = following
-            break
+            following, newton = 0.5 * (low + high), False
+        if abs(following - theta) < (NEWTON_TOLERANCE if newton else 1e-15):
+            return following, newton or (rising and falling and low <= following <= high)
         theta = following
-    rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
-    return theta, rx, ry, tx, ty, second
+    return theta, rising and falling and low <= theta <= high
 
 
 @njit(cache=True)
@@ -229,6 +317,81 @@ def tightest_radius(coefficients, bearing_radius: float) -> float:
     coefficients = np.asarray(coefficients, float)
     harmonics = (coefficients.shape[0] - 1) // 2
     return _smallest_curvature_radius(coefficients, harmonics, bearing_radius, 64 * max(harmonics, 1))
+
+
+REACH_MARGIN = 1e-9  # relative: the refined tightest radius is a local minimum to round-off (golden sections to
+# 1e-13 rad change it by ~1e-26 of itself); the margin keeps the reach below it whatever the last digits
+
+
+def inner_reach(coefficients, bearing_radius: float) -> float:
+    """A lower bound (m) of the bore's inner reach: the least distance from the bore to a point inside it with two
+    nearest bore points or at a centre of curvature (its inner medial axis). A point inside nearer to the bore than
+    that has one nearest bore point, the foot of the only inward normal through it, so a minimum of the distance
+    found there by Newton's method is the global one (nearest_bore_point). The inner medial axis comes nearest the
+    bore at a centre of curvature or at the middle of a bottleneck, a chord inside the bore along the normals at
+    both its ends (Federer 1959, Curvature measures, Thm 4.8; Aamari et al. 2019, Estimating the reach of a
+    manifold), so the reach is the lesser of
+
+    - the tightest radius of curvature on the inner side (bore_curvature_radius): its local minima on 64 M angles,
+      each refined by golden sections between its neighbours (32 angles to the shortest period of the bending
+      ρ² + 2ρ'² − ρρ'', a trigonometric polynomial of degree 2 M), less REACH_MARGIN of itself;
+    - half the narrowest bottleneck: its ends' inward normals are opposite, and the normal turns with the polar angle
+      within ψ = atan(|ρ'|/ρ) of it, so they lie at least π − 2 ψ_max apart and the chord is at least
+      2 ρ_min sin(π/2 − ψ_max) = 2 ρ_min cos ψ_max long; ρ_min = R_B + min h and |ρ'|_max on 64 M angles, widened by
+      the most they can move between two angles (Σ m |c_m| and Σ m² |c_m| times half the spacing).
+
+    A bore nowhere tighter than its journal has a reach above R_J, the distance in contact; a circular bore's is R_B."""
+    coefficients = np.asarray(coefficients, float)
+    harmonics = (coefficients.shape[0] - 1) // 2
+    if harmonics <= 0:
+        return float(bearing_radius)
+    count = 64 * harmonics
+    spacing = 2.0 * math.pi / count
+    angles = spacing * np.arange(count)
+    radii = np.array([bore_curvature_radius(coefficients, harmonics, bearing_radius, theta) for theta in angles])
+    tightest = math.inf
+    for i in np.flatnonzero((radii <= np.roll(radii, 1)) & (radii <= np.roll(radii, -1)) & np.isfinite(radii)):
+        tightest = min(tightest, _golden_minimum(
+            lambda theta: bore_curvature_radius(coefficients, harmonics, bearing_radius, theta),
+            angles[i] - spacing, angles[i] + spacing))
+    orders = np.arange(1, harmonics + 1)
+    sizes = np.hypot(coefficients[1::2][:harmonics], coefficients[2::2][:harmonics])
+    slopes = np.abs(sum(order * (coefficients[2 * order] * np.cos(order * angles)
+                                 - coefficients[2 * order - 1] * np.sin(order * angles)) for order in orders))
+    smallest_radius = innermost_radius(coefficients, bearing_radius)
+    steepest = slopes.max() + float(np.sum(orders ** 2 * sizes)) * spacing / 2.0
+    half_bottleneck = smallest_radius / math.hypot(1.0, steepest / smallest_radius)
+    return min(tightest * (1.0 - REACH_MARGIN), half_bottleneck)
+
+
+def innermost_radius(coefficients, bearing_radius: float) -> float:
+    """A lower bound (m) of the bore's smallest radius ρ_min = R_B + min h: the least on 64 M angles, less the most
+    the series can move between two of them (Σ m √(a_m² + b_m²) times half their spacing)."""
+    coefficients = np.asarray(coefficients, float)
+    harmonics = (coefficients.shape[0] - 1) // 2
+    if harmonics <= 0:
+        return float(bearing_radius + (coefficients[0] if coefficients.shape[0] else 0.0))
+    angles = np.linspace(0.0, 2.0 * math.pi, 64 * harmonics, endpoint=False)
+    orders = np.arange(1, harmonics + 1)
+    slope_bound = float(np.sum(orders * np.hypot(coefficients[1::2][:harmonics], coefficients[2::2][:harmonics])))
+    return bearing_radius + float(evaluate_profile(coefficients, angles).min()) - slope_bound * (angles[1] - angles[0]) / 2.0
+
+
+def _golden_minimum(function, low: float, high: float) -> float:
+    """The least value of `function` on [low, high] found by golden sections to 1e-13 (a local minimum)."""
+    ratio = 0.5 * (math.sqrt(5.0) - 1.0)
+    left, right = high - ratio * (high - low), low + ratio * (high - low)
+    left_value, right_value = function(left), function(right)
+    while high - low > 1e-13:
+        if left_value <= right_value:
+            high, right, right_value = right, left, left_value
+            left = high - ratio * (high - low)
+            left_value = function(left)
+        else:
+            low, left, left_value = left, right, right_value
+            right = low + ratio * (high - low)
+            right_value = function(right)
+    return min(left_value, right_value, function(0.5 * (low + high)))
 
 
 @njit(cache=True)

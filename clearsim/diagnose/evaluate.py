@@ -18,17 +18,22 @@ import numpy as np
 
 from clearsim.errors import ClearsimError
 from clearsim.model.loader import dump_yaml
+from clearsim.solver.outputs import IMPACT
 from clearsim.sweep.worker import COMPLETE, CaseTask, run_case
 from clearsim.units import si_text
 
 
 @dataclass
 class Prediction:
-    """What a run predicts: all its sensors over its time grid; `error` when it failed."""
+    """What a run predicts: all its sensors over its time grid; `error` when it failed; `impacts`, its clearance
+    joints' contact episodes of kind impact (dry strikes of a journal on its bearing's wall, each as short as a Hertz
+    contact: the events a chaotic impact sequence is made of; a film that carries the load, or a journal riding the wall
+    in continuous contact, has none)."""
 
     time: np.ndarray
     sensors: dict[str, np.ndarray]
     error: str = ""
+    impacts: int = 0
 
     @property
     def ok(self) -> bool:
@@ -39,11 +44,19 @@ def document_text(document: dict) -> str:
     return dump_yaml(document)
 
 
-def _read_sensors(path: Path) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+def read_prediction(path: Path) -> Prediction:
+    """A complete run's file: its sensors and its impacts (the `kind` column of each clearance joint's episode table,
+    written in every file whatever its `contents`: a byte per contact episode)."""
     with h5py.File(path, "r") as handle:
         sensors = handle.get("sensors")
         values = {name: np.asarray(sensors[name][()], float) for name in sensors} if sensors is not None else {}
-        return np.asarray(handle["time"][()], float), values
+        return Prediction(np.asarray(handle["time"][()], float), values, impacts=_impacts(handle))
+
+
+def _impacts(handle: h5py.File) -> int:
+    joints = handle.get("joints")
+    kinds = [joints[name]["episodes"]["kind"][()] for name in joints if "episodes" in joints[name]] if joints else []
+    return int(sum(np.count_nonzero(k == IMPACT) for k in kinds))
 
 
 class Evaluator:
@@ -99,7 +112,7 @@ class Evaluator:
             if outcome.unwritten:  # a full disk: a fault of the machine, not a model that fails
                 raise ClearsimError(outcome.error)
             if outcome.state == COMPLETE:
-                self._memory[outcome.name] = Prediction(*_read_sensors(Path(todo[outcome.name].output)))
+                self._memory[outcome.name] = read_prediction(Path(todo[outcome.name].output))
             else:
                 self._memory[outcome.name] = Prediction(np.empty(0), {}, outcome.error or outcome.state)
             finish(outcome.name)

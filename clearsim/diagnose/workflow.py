@@ -532,7 +532,7 @@ def _iterate(evaluator, record, sensors, document, kinds, found_keys, units, req
         ranked = judge(scored, baseline, record)
     winner = ranked[0] if ranked and ranked[0].fitted and ranked[0].delta_bic < -SIGNIFICANCE else None
     rejected = ""  # why the significant winner is not named (§4 steps 3 and 5)
-    if (winner is not None and rattles_with(winner, document, request)
+    if (winner is not None and rattles(winner)
             and not seen_below_chaos(winner, base_point, record)):
         rejected = (f"{winner.candidate.label} fits better (ΔBIC {winner.delta_bic:.0f}) only above the screening band "
                     f"({record.low_band.cutoff:.0f} Hz; there χ² {low_band_best(winner):.1f} against the model's "
@@ -651,12 +651,14 @@ def has_clearance_joint(mechanism) -> bool:
     return any(is_clearance_joint(j) for j in mechanism.joints)
 
 
-def rattles_with(scored: Scored, document: dict, request: DiagnoseRequest) -> bool:
-    """The model with the candidate's estimate has a clearance joint (its own or one the candidate adds): only then can
-    a run match the record's impacts by chance, and only then does seen_below_chaos apply. Without one, a lower χ² in
-    the comparison band alone is the candidate's signature (a drive lag's start-up transient, over before the screening
-    band's compared samples begin), not luck."""
-    return has_clearance_joint(_mechanism(scored.candidate.applied(document, scored.estimate.value), request))
+def rattles(scored: Scored) -> bool:
+    """The run the candidate reports (its estimate) has impacts: a clearance joint's journal strikes its wall
+    (Prediction.impacts). Only then can a run match the record's impact sequence by chance, and only then does
+    seen_below_chaos apply. Without impacts, a lower χ² in the comparison band alone is the candidate's signature, not
+    luck: a drive lag's start-up transient (over before the screening band's compared samples begin) in a mechanism
+    without clearance, an oil film's response in a lubricated joint whose film carries the load, or whose journal rides
+    its wall in continuous contact."""
+    return scored.estimate.prediction.impacts > 0
 
 
 def seen_below_chaos(scored: Scored, baseline: Point, record: Record) -> bool:

@@ -319,8 +319,8 @@ def tightest_radius(coefficients, bearing_radius: float) -> float:
     return _smallest_curvature_radius(coefficients, harmonics, bearing_radius, 64 * max(harmonics, 1))
 
 
-REACH_MARGIN = 1e-9  # relative: the refined tightest radius is a local minimum to round-off (golden sections to
-# 1e-13 rad change it by ~1e-26 of itself); the margin keeps the reach below it whatever the last digits
+REACH_MARGIN = 1e-9  # relative: the refined tightest radius is a local minimum to round-off (its argument to
+# 1e-13 rad changes it by ~1e-26 of itself); the margin keeps the reach below it whatever the last digits
 
 
 def inner_reach(coefficients, bearing_radius: float) -> float:
@@ -333,7 +333,7 @@ def inner_reach(coefficients, bearing_radius: float) -> float:
     manifold), so the reach is the lesser of
 
     - the tightest radius of curvature on the inner side (bore_curvature_radius): its local minima on 64 M angles,
-      each refined by golden sections between its neighbours (32 angles to the shortest period of the bending
+      each refined by bounded Brent minimisation between its neighbours (32 angles to the shortest period of the bending
       ρ² + 2ρ'² − ρρ'', a trigonometric polynomial of degree 2 M), less REACH_MARGIN of itself;
     - half the narrowest bottleneck: its ends' inward normals are opposite, and the normal turns with the polar angle
       within ψ = atan(|ρ'|/ρ) of it, so they lie at least π − 2 ψ_max apart and the chord is at least
@@ -351,7 +351,7 @@ def inner_reach(coefficients, bearing_radius: float) -> float:
     radii = np.array([bore_curvature_radius(coefficients, harmonics, bearing_radius, theta) for theta in angles])
     tightest = math.inf
     for i in np.flatnonzero((radii <= np.roll(radii, 1)) & (radii <= np.roll(radii, -1)) & np.isfinite(radii)):
-        tightest = min(tightest, _golden_minimum(
+        tightest = min(tightest, _least_between(
             lambda theta: bore_curvature_radius(coefficients, harmonics, bearing_radius, theta),
             angles[i] - spacing, angles[i] + spacing))
     orders = np.arange(1, harmonics + 1)
@@ -377,21 +377,13 @@ def innermost_radius(coefficients, bearing_radius: float) -> float:
     return bearing_radius + float(evaluate_profile(coefficients, angles).min()) - slope_bound * (angles[1] - angles[0]) / 2.0
 
 
-def _golden_minimum(function, low: float, high: float) -> float:
-    """The least value of `function` on [low, high] found by golden sections to 1e-13 (a local minimum)."""
-    ratio = 0.5 * (math.sqrt(5.0) - 1.0)
-    left, right = high - ratio * (high - low), low + ratio * (high - low)
-    left_value, right_value = function(left), function(right)
-    while high - low > 1e-13:
-        if left_value <= right_value:
-            high, right, right_value = right, left, left_value
-            left = high - ratio * (high - low)
-            left_value = function(left)
-        else:
-            low, left, left_value = left, right, right_value
-            right = low + ratio * (high - low)
-            right_value = function(right)
-    return min(left_value, right_value, function(0.5 * (low + high)))
+def _least_between(function, low: float, high: float) -> float:
+    """The least value of `function` on [low, high] (a local minimum: bounded Brent, scipy's minimize_scalar, to
+    1e-13 in its argument)."""
+    from scipy.optimize import minimize_scalar  # here: only a model with a worn bore needs it (36 MB in each worker)
+
+    found = minimize_scalar(function, bounds=(low, high), method="bounded", options={"xatol": 1e-13})
+    return min(float(found.fun), function(low), function(high))
 
 
 @njit(cache=True)

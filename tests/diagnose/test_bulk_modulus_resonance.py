@@ -6,42 +6,27 @@ import json
 from pathlib import Path
 
 import pytest
+import yaml
 from typer.testing import CliRunner
 
 from clearsim.cli import app
 
+from .drive_mechanisms import CYLINDER
+
 runner = CliRunner()
 
-# a 10 kg block closed by a cylinder onto its cushion, which seals 5 mm before the end of the stroke: the block then
-# rings on the trapped rod-side oil at ~250 Hz, lightly damped, for the last 65 ms of the 100 ms record
-RINGING_CYLINDER = """
-name: hydraulic cylinder closing a block onto its oil cushion
-points: {O: [0 m, 0 m], C: [-0.5 m, 0 m]}
-bodies:
-  - {name: block, mass: 10 kg, inertia: 0.01 kg*m^2, position: [0 m, 0 m]}
-joints:
-  - {name: guide, type: prismatic, bodies: [ground, block], at: O, axis: [1, 0]}
-forces:
-  - name: actuator
-    type: hydraulic_cylinder
-    bodies: [ground, block]
-    at: [C, O]
-    stroke: 60 mm
-    piston_area: 10 cm^2
-    rod_side_area: 5 cm^2
-    dead_volumes: [50 cm^3, 10 cm^3]
-    bulk_modulus: 1.4 GPa
-    supply: {type: accumulator, pressure: 100 bar, gas_volume: 1 L, polytropic_index: 1.4}
-    ports: {piston: valve, rod: tank}
-    port_areas: {piston: 20 mm^2, rod: 20 mm^2}
-    valve: {law: linear, delay: 0 ms, opening_time: 5 ms}
-    cushion: {law: table, points: [[50 mm, 1], [54 mm, 0.3], [55 mm, 0]]}
-sensors:
-  - {name: travel, type: point_displacement, body: block, direction: [1, 0]}
-  - {name: speed, type: point_velocity, body: block, direction: [1, 0]}
-output: {displacement: travel, velocity: speed}
-solver: {t_end: 100 ms, output_rate: 10 kHz}
-"""
+
+def ringing_cylinder() -> str:
+    """The block of drive_mechanisms.CYLINDER without its spring, closed onto a cushion that seals 5 mm before the end
+    of the stroke: it then rings on the trapped rod-side oil at ~250 Hz, lightly damped, for the last 65 ms of 100 ms."""
+    document = yaml.safe_load(CYLINDER)
+    cylinder = next(f for f in document["forces"] if f["type"] == "hydraulic_cylinder")
+    cylinder.update(dead_volumes=["50 cm^3", "10 cm^3"], valve={"law": "linear", "delay": "0 ms", "opening_time": "5 ms"},
+                    cushion={"law": "table", "points": [["50 mm", 1], ["54 mm", 0.3], ["55 mm", 0]]})
+    document["name"] = "hydraulic cylinder closing a block onto its oil cushion"
+    document["forces"] = [cylinder]
+    document["solver"]["t_end"] = "100 ms"
+    return yaml.safe_dump(document, sort_keys=False)
 
 
 def test_a_bulk_modulus_that_sets_the_cushion_ringing_is_found_in_its_narrow_well(tmp_path: Path):
@@ -49,7 +34,7 @@ def test_a_bulk_modulus_that_sets_the_cushion_ringing_is_found_in_its_narrow_wel
     interval holds it and the record is explained. Scanned only, the fit lands beside the well (0.888 GPa, gap 50.3 →
     3.58, unexplained)."""
     config = tmp_path / "cylinder.yaml"
-    config.write_text(RINGING_CYLINDER)
+    config.write_text(ringing_cylinder())
     record = tmp_path / "bench.csv"
     result = runner.invoke(app, ["synthesize", str(config), "--set", "forces.actuator.bulk_modulus=0.88 GPa",
                                  "--sensors", "travel,speed", "--rate", "10kHz", "--noise", "0.1%", "--seed", "3",

@@ -2,18 +2,13 @@
 and over many cycles a β a few % off rings out of phase with the record, a narrow well in β that the scan misses. The
 candidate is screened with frequency-matched values (docs/diagnose.md §4 step 1), as a compliance is."""
 
-import json
 from pathlib import Path
 
 import pytest
 import yaml
-from typer.testing import CliRunner
-
-from clearsim.cli import app
 
 from .drive_mechanisms import CYLINDER
-
-runner = CliRunner()
+from .test_drive_candidates import diagnosed
 
 
 def ringing_cylinder() -> str:
@@ -33,17 +28,8 @@ def test_a_bulk_modulus_that_sets_the_cushion_ringing_is_found_in_its_narrow_wel
     """β 0.88 GPa hidden (1.4 in the model; off the scan points), 0.1 % noise: the diagnosis finds it within 0.5 %, its
     interval holds it and the record is explained. Scanned only, the fit lands beside the well (0.888 GPa, gap 50.3 →
     3.58, unexplained)."""
-    config = tmp_path / "cylinder.yaml"
-    config.write_text(ringing_cylinder())
-    record = tmp_path / "bench.csv"
-    result = runner.invoke(app, ["synthesize", str(config), "--set", "forces.actuator.bulk_modulus=0.88 GPa",
-                                 "--sensors", "travel,speed", "--rate", "10kHz", "--noise", "0.1%", "--seed", "3",
-                                 "-o", str(record)])
-    assert result.exit_code == 0, result.output
-    result = runner.invoke(app, ["diagnose", str(config), "--measured", str(record), "-o", str(tmp_path / "report"),
-                                 "--workers", "2", "--candidates", "bulk_modulus,port_area"])
-    assert result.exit_code == 0, result.output
-    found = json.loads((tmp_path / "report" / "diagnosis.json").read_text())
+    found = diagnosed(tmp_path, ringing_cylinder(), "forces.actuator.bulk_modulus=0.88 GPa", "bulk_modulus,port_area",
+                      ["--sensors", "travel,speed", "--rate", "10kHz", "--noise", "0.1%", "--seed", "3"])
     effect = found["effects"][0]
     assert (effect["kind"], effect["target"]) == ("bulk_modulus", "actuator")
     assert effect["parameters"]["bulk modulus"] == pytest.approx(0.88e9, rel=5e-3)

@@ -503,6 +503,7 @@ class ForceParameter:
     factors: tuple[float, float]
     display_unit: tuple[str, float]
     present: Callable  # the force element → the parameter's value in the model as given (None: not this element's)
+    resonant: bool = False  # a stiffness setting a resonance, frequency ∝ √value (Candidate.resonant)
 
 
 def _force_candidates(mechanism, spec: ForceParameter) -> list[Candidate]:
@@ -518,7 +519,7 @@ def _force_candidates(mechanism, spec: ForceParameter) -> list[Candidate]:
 
         out.append(Candidate(spec.kind, force.name, spec.parameter, DIMENSIONS[spec.dimension].si_unit,
                              spec.factors[0] * present, spec.factors[1] * present, True, present, write,
-                             spec.display_unit))
+                             spec.display_unit, resonant=spec.resonant))
     return out
 
 
@@ -550,8 +551,10 @@ port_area = _force_kind(
                    PORT_AREA_FACTORS, ("mm²", 1e-6), lambda f: f.port_areas.rod))
 precharge = _force_kind(ForceParameter("precharge", "hydraulic_cylinder", "accumulator precharge", "supply.pressure",
                                        "pressure", PRECHARGE_FACTORS, ("bar", 1e5), _accumulator_pressure))
+# the oil column is a spring k = β A²/V: where the cylinder rings against it (the trapped oil at the end stop), f ∝ √β
 bulk_modulus = _force_kind(ForceParameter("bulk_modulus", "hydraulic_cylinder", "bulk modulus", "bulk_modulus",
-                                          "pressure", BULK_MODULUS_FACTORS, ("GPa", 1e9), lambda f: f.bulk_modulus))
+                                          "pressure", BULK_MODULUS_FACTORS, ("GPa", 1e9), lambda f: f.bulk_modulus,
+                                          resonant=True))
 preload = _force_kind(ForceParameter("preload", "spring_drive", "preload", "preload", "force", PRELOAD_FACTORS,
                                      ("N", 1.0), lambda f: f.preload))
 dashpot = _force_kind(

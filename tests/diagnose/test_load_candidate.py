@@ -3,18 +3,14 @@ the ground gets one, a force along the joint's axis over −F_max … F_max with
 kinetic energy over the slider's travel, from a run of the model as given), and `diagnose` names a hidden load on the
 spring-driven block of tests/diagnose/drive_mechanisms.py."""
 
-import json
-from pathlib import Path
-
 import pytest
 import yaml
-from typer.testing import CliRunner
 
-from clearsim.cli import app
 from clearsim.diagnose.candidates import candidates_for
 from clearsim.diagnose.evaluate import document_text
 from clearsim.model.loader import load_mechanism_text
 from tests.diagnose.drive_mechanisms import SPRING_DRIVE
+from tests.diagnose.test_drive_candidates import diagnosis_of, recorded
 
 PUSH = 50.0  # N, the pushed block's only force: the work-energy theorem makes E_max / s exactly this
 PUSHED_BLOCK = f"""
@@ -71,14 +67,7 @@ def test_a_hidden_constant_load_on_the_spring_driven_block_is_named_and_its_inte
     mechanism, document = loaded(SPRING_DRIVE)
     truth = tmp_path / "truth.yaml"
     truth.write_text(document_text(candidates_for(mechanism, document, ["load"])[0].applied(document, HIDDEN)))
-    runner = CliRunner()
-    record = tmp_path / "bench.csv"
-    result = runner.invoke(app, ["synthesize", str(truth), *BLOCK_BENCH, "-o", str(record)])
-    assert result.exit_code == 0, result.output
-    result = runner.invoke(app, ["diagnose", str(model), "--measured", str(record), "-o", str(tmp_path / "report"),
-                                 "--workers", "2", "--candidates", "load,dashpot,gas_load"])
-    assert result.exit_code == 0, result.output
-    found = json.loads((tmp_path / "report" / "diagnosis.json").read_text())
+    found = diagnosis_of(tmp_path, model, recorded(tmp_path, truth, BLOCK_BENCH), "load,dashpot,gas_load")
     effect = found["effects"][0]
     assert (effect["kind"], effect["target"]) == ("load", "block")
     low, high = effect["interval"]["force"]

@@ -487,7 +487,7 @@ def diagnose(
     candidates: Optional[str] = typer.Option(
         None, "--candidates", help="Kinds of effect to try, e.g. clearance,friction (default all): clearance, friction, "
         "stiffness, restitution, drive, damping, mass, compliance, beam_stiffness, contact_length, port_area, precharge, "
-        "bulk_modulus, preload, dashpot, gas_load, guide_friction, wear, viscosity."),
+        "bulk_modulus, preload, dashpot, gas_load, guide_friction, wear, viscosity, load."),
     max_effects: int = typer.Option(1, "--max-effects", help="Add up to N effects, one per iteration (greedy)."),
     out: Optional[Path] = typer.Option(None, "-o", "--out", help="Report folder (default: results/diagnose-<config>-<record>/)."),
     lowpass: Optional[str] = typer.Option(None, "--lowpass", help="The bench's low-pass filter if known: 2kHz (default: estimated from the record)."),

@@ -10,14 +10,16 @@ from __future__ import annotations
 
 import copy
 import math
+import tempfile
 from dataclasses import dataclass, replace
-from functools import partial
+from functools import lru_cache, partial
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
 from clearsim.model.flexible import initial_tensions, link_split, point_text, set_spring, split_link, two_joint_links
+from clearsim.model.loader import dump_yaml, load_mechanism_text
 from clearsim.model.overrides import apply_overrides
 from clearsim.model.resolve import is_clearance_joint, resolve_clearance
 from clearsim.model.schema import Mechanism, StrokeMotion
@@ -116,7 +118,8 @@ KIND_TITLES = {"clearance": "clearance", "friction": "friction", "stiffness": "c
                "compliance": "axial compliance", "beam_stiffness": "bending stiffness",
                "contact_length": "pin contact length", "port_area": "port area", "precharge": "accumulator precharge",
                "bulk_modulus": "oil bulk modulus", "preload": "spring preload", "dashpot": "dashpot",
-               "gas_load": "gas load", "guide_friction": "guide friction", "wear": "wear", "viscosity": "oil viscosity"}
+               "gas_load": "gas load", "guide_friction": "guide friction", "wear": "wear", "viscosity": "oil viscosity",
+               "load": "constant load"}
 JOINT_KINDS = {"clearance", "friction", "stiffness", "restitution", "contact_length", "wear", "viscosity"}
 PARAMETER_NAMED = {"drive", "port_area", "dashpot"}  # kinds with several parameters per target: the label names it
 
@@ -490,6 +493,71 @@ def beam_stiffness(mechanism, document) -> list[Candidate]:
     return out
 
 
+def _ground_sliders(mechanism) -> dict[str, tuple[float, float]]:
+    """Each body that slides in a prismatic joint on the ground, and that joint's unit axis (the first such joint
+    in file order). A slider on a moving guide has none: its axis turns with the guide, which a constant force in the
+    global frame does not follow."""
+    sliders: dict[str, tuple[float, float]] = {}
+    for joint in mechanism.joints:
+        if joint.type == "prismatic" and joint.bodies[0] == "ground":
+            sliders.setdefault(joint.bodies[1], tuple(float(x) for x in joint.axis))
+    return sliders
+
+
+def load_scales(document: dict, base_dir: Path, axes: dict[str, tuple[float, float]]) -> dict[str, float]:
+    """F_max = E_max / s of each slider (N): E_max the largest kinetic energy of the whole mechanism and s the
+    slider's travel along its axis (max − min), both in one run of the model as given: a constant load doing the work
+    of the mechanism's peak kinetic energy over that travel. A slider that does not travel (s below 1 µm) or a model
+    that does not run to its end gets none."""
+    return dict(_load_scales(dump_yaml(document), str(base_dir), tuple(sorted(axes.items()))))
+
+
+@lru_cache(maxsize=8)
+def _load_scales(text: str, base_dir: str, axes: tuple) -> tuple:
+    import h5py
+
+    from clearsim.runner import prepare, run_to_file
+
+    loaded = load_mechanism_text(text, "load scale", (), Path(base_dir))
+    system = prepare(loaded)  # its bodies: a flexible link's halves and segments in place of the link
+    with tempfile.TemporaryDirectory() as folder:
+        report = run_to_file(system, loaded, Path(folder) / "model.h5")
+        if not report.complete:
+            return ()
+        with h5py.File(report.output, "r") as result:
+            energy = sum(_kinetic_energy(body, result[f"bodies/{body.name}/qd"][:]) for body in system.mechanism.bodies)
+            travels = {body: float(np.ptp(result[f"bodies/{body}/q"][:, :2] @ np.asarray(axis))) for body, axis in axes}
+    return tuple((body, float(np.max(energy)) / travel) for body, travel in travels.items() if travel > MIN_TRAVEL)
+
+
+def _kinetic_energy(body, velocities: np.ndarray) -> np.ndarray:
+    """½ m (ẋ² + ẏ²) + ½ J θ̇² of a body at each sample (J about its centre of mass)."""
+    return 0.5 * body.mass * (velocities[:, 0] ** 2 + velocities[:, 1] ** 2) + 0.5 * body.inertia * velocities[:, 2] ** 2
+
+
+MIN_TRAVEL = 1e-6  # m: a slider that moves less has no load scale (E_max / s)
+
+
+def load(mechanism, document, base_dir: Path = Path(".")) -> list[Candidate]:
+    """A constant force F on each body sliding in a prismatic joint on the ground, along that joint's axis (positive
+    in the axis's direction), written as a `constant` force element at its centre of mass: seal or guide friction,
+    a gas or spring force, a cable the model lacks. −F_max … F_max (load_scales), present value 0 N."""
+    axes = _ground_sliders(mechanism)
+    scales = load_scales(document, base_dir, axes) if axes else {}
+    out = []
+    for body, axis in axes.items():
+        if body not in scales:
+            continue
+
+        def write(doc, value, name=body, axis=axis):
+            forces = [f for f in doc.get("forces") or [] if f.get("name") != f"diagnose_load_{name}"]
+            doc["forces"] = forces + [{"type": "constant", "name": f"diagnose_load_{name}", "body": name,
+                                       "force": [si_text(value * axis[0], "force"), si_text(value * axis[1], "force")]}]
+
+        out.append(Candidate("load", body, "force", "N", -scales[body], scales[body], False, 0.0, write, ("N", 1.0)))
+    return out
+
+
 @dataclass(frozen=True)
 class ForceParameter:
     """A parameter of a force element of type `force_type`, written at `forces.<name>.<path>` in SI units of
@@ -574,12 +642,12 @@ KINDS: dict[str, Callable] = {"clearance": clearance, "friction": friction, "sti
                               "contact_length": contact_length, "port_area": port_area, "precharge": precharge,
                               "bulk_modulus": bulk_modulus, "preload": preload, "dashpot": dashpot,
                               "gas_load": gas_load, "guide_friction": guide_friction, "wear": wear,
-                              "viscosity": viscosity}
+                              "viscosity": viscosity, "load": load}
 
 
 def candidates_for(mechanism, document: dict, kinds: list[str], base_dir: Path | str = ".") -> list[Candidate]:
     """The candidates of the kinds; `base_dir`: where the file's tables are (a compliance assembles the model)."""
-    makers = {**KINDS, "compliance": partial(compliance, base_dir=Path(base_dir))}
+    makers = {**KINDS, "compliance": partial(compliance, base_dir=Path(base_dir)), "load": partial(load, base_dir=Path(base_dir))}
     return [c for kind in kinds for c in makers[kind](mechanism, document)]
 
 

@@ -4,8 +4,8 @@
                                                [--workers 2] [--table]
 
 Each case writes the model with one effect into `truth.yaml` (a candidate of the diagnosis at a value off its scan
-points, or an effect no candidate describes: an external force, a wrong link length, a mass change when masses are
-not candidates; or nothing), synthesizes a bench record from it (`clearsim synthesize`), diagnoses the model without
+points, or an effect no candidate describes: a wrong link length or pivot, a damper engaging later, a mass change when
+masses are not candidates; or nothing), synthesizes a bench record from it (`clearsim synthesize`), diagnoses the model without
 it (`clearsim diagnose`, the CLI's code path) and scores the report:
 
 - right effect: the first effect named is the hidden one (kind, target, parameter);
@@ -63,25 +63,18 @@ class Case:
     candidates: str
     hidden: tuple[str, str, str, float] | None = None  # (kind, target, parameter, value): a candidate's effect
     outside: list[str] = field(default_factory=list)  # --set of an effect no candidate describes
-    force: dict | None = None  # a force element added to the record's model (outside the candidate set)
     seed: int = 3
 
     @property
     def kind(self) -> str:
-        return "effect" if self.hidden else "outside" if (self.outside or self.force) else "null"
+        return "effect" if self.hidden else "outside" if self.outside else "null"
 
     @property
     def truth(self) -> str:
         if self.hidden:
             kind, target, parameter, value = self.hidden
             return f"{kind} {target} {parameter} {value:.4g}"
-        if self.force:
-            return f"outside: force {self.force['force']} on {self.force['body']}"
         return f"outside: {' '.join(self.outside)}" if self.outside else "none"
-
-
-def slider_force(newtons: float) -> dict:
-    return {"name": "hidden_push", "type": "constant", "body": "slider", "force": [f"{newtons} N", "0 N"]}
 
 
 UHV_KINDS = "clearance,drive,compliance,mass"
@@ -115,7 +108,7 @@ CASES = [
          ("friction", "slider_pin", "mu_d", 0.11)),
     Case("crank-null-low", SLIDER_CRANK, CRANK_RIGID, CRANK_BENCH, low, "clearance,drive,mass", seed=6),
     Case("crank-null-high", SLIDER_CRANK, CRANK_RIGID, CRANK_BENCH, high, CRANK_KINDS, seed=7),
-    Case("crank-force-mid", SLIDER_CRANK, [], CRANK_BENCH, mid, "clearance,drive,mass", force=slider_force(30.0)),
+    Case("crank-load-mid", SLIDER_CRANK, [], CRANK_BENCH, mid, "clearance,drive,mass,load", ("load", "slider", "force", 30.0)),
     Case("crank-rod-length-low", SLIDER_CRANK, CRANK_RIGID, CRANK_BENCH, low, "clearance,drive,mass",
          outside=["points.B=[0.173 m, 0 m]"]),
     # UHV breaker (prescribed drive), frictionless ideal joints: the cheap variant of the studies
@@ -150,8 +143,8 @@ CASES = [
          ("mass", "insulating_pole", "mass factor", 1.23)),
     Case("hydraulic-damping-low", HYDRAULIC, [], DRIVE_BENCH, low, "port_area,precharge,mass,damping",
          ("damping", "moving_contact", "damping", 500.0)),
-    Case("hydraulic-force-low", HYDRAULIC, [], DRIVE_BENCH, low, CYLINDER_KINDS,
-         force={"name": "hidden_push", "type": "constant", "body": "moving_contact", "force": ["0 N", "1500 N"]}),
+    Case("hydraulic-load-low", HYDRAULIC, [], DRIVE_BENCH, low, CYLINDER_KINDS + ",load",
+         ("load", "moving_contact", "force", 1700.0)),
     Case("hydraulic-null-mid", HYDRAULIC, [], DRIVE_BENCH, mid, CYLINDER_KINDS, seed=9),
     Case("hydraulic-mass-outside-low", HYDRAULIC, [], DRIVE_BENCH, low, CYLINDER_KINDS,
          outside=["bodies.moving_contact.mass=13 kg"]),
@@ -159,6 +152,8 @@ CASES = [
     Case("block-preload-low", SPRING_DRIVE, [], BLOCK_BENCH, low, BLOCK_KINDS, ("preload", "opening_spring", "preload", 2630.0)),
     Case("block-dashpot-mid", SPRING_DRIVE, [], BLOCK_BENCH, mid, BLOCK_KINDS, ("dashpot", "end_damper", "damping", 1300.0)),
     Case("block-null-high", SPRING_DRIVE, [], BLOCK_BENCH, high, BLOCK_KINDS, seed=10),
+    Case("block-damper-outside-low", SPRING_DRIVE, [], BLOCK_BENCH, low, BLOCK_KINDS + ",load",
+         outside=["forces.end_damper.engaged=[70 mm, 200 mm]"]),
     # the flexible UHV breaker: a beam's bending stiffness
     Case("flexible-beam-low", FLEXIBLE, FRICTIONLESS_UHV, UHV_CONTACT, low, "beam_stiffness,drive",
          ("beam_stiffness", "lower_turn_arm", "E·I factor", 0.62)),
@@ -167,7 +162,7 @@ CASES = [
                                                "solver.method=rosenbrock"], CRANK_BENCH, mid, "viscosity,clearance,mass",
          ("viscosity", "slider_pin", "viscosity", 0.012)),
 ]
-QUICK = ["crank-clearance-low", "crank-null-low", "crank-force-mid", "block-preload-low"]
+QUICK = ["crank-clearance-low", "crank-null-low", "crank-load-mid", "block-preload-low"]
 
 
 def model_file(case: Case, folder: Path) -> Path:
@@ -193,8 +188,6 @@ def truth_document(case: Case, config: Path) -> tuple[dict, dict]:
         unit = float(candidate.to_unit(value))
         grid = np.concatenate([SCREEN_POINTS, candidate.to_unit(candidate.grid(SCAN_POINTS))])
         placement = {"unit": unit, "off_grid": float(np.min(np.abs(grid - unit)))}
-    if case.force:
-        document.setdefault("forces", []).append(case.force)
     return document, placement
 
 

@@ -74,9 +74,19 @@ def diagnosed(tmp_path: Path, text: str, hidden: str, kinds: str, bench: list[st
 
 def diagnosed_file(tmp_path: Path, config: Path, hidden: str, kinds: str, bench: list[str]) -> dict:
     """Synthesize the bench record of `config` with `hidden` set, diagnose it against `config`; its diagnosis.json."""
+    return diagnosis_of(tmp_path, config, recorded(tmp_path, config, ["--set", hidden, *bench]), kinds)
+
+
+def recorded(tmp_path: Path, truth: Path, options: list[str]) -> Path:
+    """The bench record `clearsim synthesize` makes of the mechanism file `truth` with `options`."""
     record = tmp_path / "bench.csv"
-    result = runner.invoke(app, ["synthesize", str(config), "--set", hidden, *bench, "-o", str(record)])
+    result = runner.invoke(app, ["synthesize", str(truth), *options, "-o", str(record)])
     assert result.exit_code == 0, result.output
+    return record
+
+
+def diagnosis_of(tmp_path: Path, config: Path, record: Path, kinds: str) -> dict:
+    """The diagnosis.json of `clearsim diagnose` of `config` against `record` with the candidate `kinds`."""
     result = runner.invoke(app, ["diagnose", str(config), "--measured", str(record), "-o", str(tmp_path / "report"),
                                  "--workers", "2", "--candidates", kinds])
     assert result.exit_code == 0, result.output

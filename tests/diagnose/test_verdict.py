@@ -36,8 +36,8 @@ def diagnosed(config: Path, folder: Path, *options) -> tuple[dict, str]:
 
 
 def test_an_effect_outside_the_candidates_leaves_the_record_unexplained(tmp_path):
-    """A constant 30 N push on the slider (no candidate kind for a force): the rod's mass takes up a fifth of it on
-    both halves and in every realisation alike; the record stays unexplained, and nothing is confirmed."""
+    """A constant 30 N push on the slider (the `load` kind left out of the candidates): the rod's mass takes up a
+    fifth of it on both halves and in every realisation alike; the record stays unexplained, and nothing is confirmed."""
     truth = yaml.safe_load(SLIDER_CRANK.read_text())
     truth["forces"] = [{"type": "constant", "name": "push", "body": "slider", "force": ["30 N", "0 N"]}]
     config = tmp_path / "pushed.yaml"

@@ -4,8 +4,8 @@
                                                [--workers 2] [--table]
 
 Each case writes the model with one effect into `truth.yaml` (a candidate of the diagnosis at a value off its scan
-points, a worn arc at an angle off the ones it tries, or an effect no candidate describes: a wrong link length or pivot, a damper engaging later, a mass change when
-masses are not candidates; or nothing), synthesizes a bench record from it (`clearsim synthesize`), diagnoses the model without
+points, a worn arc at an angle off the ones it tries, or an effect no candidate describes: a wrong link length or
+pivot, a damper engaging later, a mass change when masses are not candidates; or nothing), synthesizes a bench record from it (`clearsim synthesize`), diagnoses the model without
 it (`clearsim diagnose`, the CLI's code path) and scores the report:
 
 - right effect: the first effect named is the hidden one (kind, target, parameter);

@@ -4,8 +4,8 @@
                                                [--workers 2] [--table]
 
 Each case writes the model with one effect into `truth.yaml` (a candidate of the diagnosis at a value off its scan
-points, or an effect no candidate describes: a wrong link length or pivot, a damper engaging later, a mass change when
-masses are not candidates; or nothing), synthesizes a bench record from it (`clearsim synthesize`), diagnoses the model without
+points, a worn arc at an angle off the ones it tries, or an effect no candidate describes: a wrong link length or
+pivot, a damper engaging later, a mass change when masses are not candidates; or nothing), synthesizes a bench record from it (`clearsim synthesize`), diagnoses the model without
 it (`clearsim diagnose`, the CLI's code path) and scores the report:
 
 - right effect: the first effect named is the hidden one (kind, target, parameter);
@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import subprocess
 import sys
 import time
@@ -33,7 +34,7 @@ import yaml
 
 from diagnose_studies import CLEARSIM, CONFIGS, CRANK_BENCH, FRICTION_CRANK, FRICTIONLESS_UHV, SLIDER_CRANK, UHV, sets
 
-from clearsim.diagnose.candidates import candidates_for
+from clearsim.diagnose.candidates import _worn_arcs, candidates_for
 from clearsim.diagnose.evaluate import document_text
 from clearsim.diagnose.search import SCAN_POINTS, SCREEN_POINTS
 from clearsim.model.loader import load_mechanism
@@ -50,6 +51,7 @@ UHV_CONTACT = ["--sensors", "contact_displacement,contact_velocity", *UHV_BENCH[
 DRIVE_BENCH = ["--sensors", "contact_displacement,contact_velocity", "--rate", "10kHz"]
 BLOCK_BENCH = ["--sensors", "travel,speed", "--rate", "10kHz"]
 CRANK_RIGID = ["joints.slider_pin.clearance=0"]
+CRANK_CYLINDRICAL_PIN = ["joints.slider_pin.contact={elastic: liu, length: 20 mm}"]
 IDENTIFIABLE_GAP = 3.0
 
 
@@ -64,6 +66,7 @@ class Case:
     hidden: tuple[str, str, str, float] | None = None  # (kind, target, parameter, value): a candidate's effect
     outside: list[str] = field(default_factory=list)  # --set of an effect no candidate describes
     seed: int = 3
+    angle: float | None = None  # deg: where a hidden worn arc lies in its bearing body's frame (a wear case)
 
     @property
     def kind(self) -> str:
@@ -73,7 +76,8 @@ class Case:
     def truth(self) -> str:
         if self.hidden:
             kind, target, parameter, value = self.hidden
-            return f"{kind} {target} {parameter} {value:.4g}"
+            around = f" around {self.angle:g}°" if self.angle is not None else ""
+            return f"{kind} {target} {parameter} {value:.4g}{around}"
         return f"outside: {' '.join(self.outside)}" if self.outside else "none"
 
 
@@ -106,6 +110,13 @@ CASES = [
          ("stiffness", "slider_pin", "stiffness", 2.0e10)),
     Case("crank-friction-low", FRICTION_CRANK, [], CRANK_BENCH, low, "friction,restitution,clearance",
          ("friction", "slider_pin", "mu_d", 0.11)),
+    # a worn arc at the slider pin, where the rod pulls the slider back at outer dead centre (the bore's most loaded
+    # side, 165–180°), 0.15 mm deep: 30 % of its 0.5 mm clearance
+    Case("crank-wear-mid", SLIDER_CRANK, [], CRANK_BENCH, mid, "wear,clearance,restitution",
+         ("wear", "slider_pin", "depth", 0.15e-3), seed=11, angle=170.0),
+    # the slider pin as a 20 mm pin in a conformal (Liu) contact; the record's pin bears on 13 mm of it (misalignment)
+    Case("crank-contact-length-low", SLIDER_CRANK, CRANK_CYLINDRICAL_PIN, CRANK_BENCH, low,
+         "contact_length,restitution,clearance", ("contact_length", "slider_pin", "length", 13e-3), seed=12),
     Case("crank-null-low", SLIDER_CRANK, CRANK_RIGID, CRANK_BENCH, low, "clearance,drive,mass", seed=6),
     Case("crank-null-high", SLIDER_CRANK, CRANK_RIGID, CRANK_BENCH, high, CRANK_KINDS, seed=7),
     Case("crank-load-mid", SLIDER_CRANK, [], CRANK_BENCH, mid, "clearance,drive,mass,load", ("load", "slider", "force", 30.0)),
@@ -181,14 +192,23 @@ def truth_document(case: Case, config: Path) -> tuple[dict, dict]:
     document = yaml.safe_load(loaded.resolved_yaml)
     placement = {}
     if case.hidden:
-        kind, target, parameter, value = case.hidden
-        candidate = next(c for c in candidates_for(loaded.mechanism, document, [kind], config.parent)
-                         if (c.target, c.parameter) == (target, parameter))
+        value = case.hidden[3]
+        candidate = hidden_candidate(case, loaded.mechanism, document, config.parent)
         document = candidate.applied(document, value)
         unit = float(candidate.to_unit(value))
         grid = np.concatenate([SCREEN_POINTS, candidate.to_unit(candidate.grid(SCAN_POINTS))])
         placement = {"unit": unit, "off_grid": float(np.min(np.abs(grid - unit)))}
     return document, placement
+
+
+def hidden_candidate(case: Case, mechanism, document: dict, base_dir: Path):
+    """The candidate whose effect the case hides: a worn arc at the case's angle (off the 30° positions the diagnosis
+    screens), or the candidate of the hidden kind, target and parameter."""
+    kind, target, parameter, _ = case.hidden
+    if case.angle is not None:
+        joint = next(j for j in mechanism.joints if j.name == target)
+        return _worn_arcs(mechanism, joint, [math.radians(case.angle)])[0]
+    return next(c for c in candidates_for(mechanism, document, [kind], base_dir) if (c.target, c.parameter) == (target, parameter))
 
 
 def run_case(case: Case, root: Path, workers: int) -> dict:

@@ -353,16 +353,16 @@ def wear(mechanism, document) -> list[Candidate]:
     φ = 0°, 30°, … in the bearing body's frame, its parameter the peak depth d (2 µm … 0.5 mm, or less than the
     wall's thickness leaves)."""
     angles = np.arange(0.0, 2.0 * math.pi - 1e-9, WEAR_ANGLE_STEP)
-    return [c for joint in _clearance_joints(mechanism) for c in _worn_arcs(mechanism, joint, angles)]
+    return [c for joint in _clearance_joints(mechanism) for c in worn_arcs(mechanism, joint, angles)]
 
 
 def wear_between(mechanism, candidate: Candidate) -> list[Candidate]:
     """The worn arc of a wear candidate's joint halfway to the positions beside it, φ ± 15°: its angle refined."""
     joint = next(j for j in mechanism.joints if j.name == candidate.target)
-    return _worn_arcs(mechanism, joint, [candidate.angle - WEAR_ANGLE_STEP / 2.0, candidate.angle + WEAR_ANGLE_STEP / 2.0])
+    return worn_arcs(mechanism, joint, [candidate.angle - WEAR_ANGLE_STEP / 2.0, candidate.angle + WEAR_ANGLE_STEP / 2.0])
 
 
-def _worn_arcs(mechanism, joint, angles) -> list[Candidate]:
+def worn_arcs(mechanism, joint, angles) -> list[Candidate]:
     """A worn arc at each angle of a clearance joint's bore (none when its wall leaves no room for one)."""
     parameters = resolve_clearance(joint, mechanism.defaults)
     radius, clearance = parameters.bearing_radius, parameters.clearance

@@ -34,7 +34,7 @@ import yaml
 
 from diagnose_studies import CLEARSIM, CONFIGS, CRANK_BENCH, FRICTION_CRANK, FRICTIONLESS_UHV, SLIDER_CRANK, UHV, sets
 
-from clearsim.diagnose.candidates import _worn_arcs, candidates_for
+from clearsim.diagnose.candidates import worn_arcs, candidates_for
 from clearsim.diagnose.evaluate import document_text
 from clearsim.diagnose.search import SCAN_POINTS, SCREEN_POINTS
 from clearsim.model.loader import load_mechanism
@@ -207,7 +207,7 @@ def hidden_candidate(case: Case, mechanism, document: dict, base_dir: Path):
     kind, target, parameter, _ = case.hidden
     if case.angle is not None:
         joint = next(j for j in mechanism.joints if j.name == target)
-        return _worn_arcs(mechanism, joint, [math.radians(case.angle)])[0]
+        return worn_arcs(mechanism, joint, [math.radians(case.angle)])[0]
     return next(c for c in candidates_for(mechanism, document, [kind], base_dir) if (c.target, c.parameter) == (target, parameter))
 
 

@@ -56,6 +56,16 @@ def peak_memory_mb(pid: int) -> float | None:
         return None
 
 
+def cpu_seconds(pid: int) -> float | None:
+    """User + system CPU time of a live process so far (Linux /proc/PID/stat); None elsewhere or when it has ended."""
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            fields = stat.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError):
+        return None
+
+
 def single_run(folder: Path) -> tuple[float, float]:
     """(total, integration) seconds of one `clearsim run` of the UHV model at 0.03 mm in A and J, a fresh process."""
     done = subprocess.run([sys.executable, "-c", SINGLE_RUN, str(UHV), str(folder / "single.h5")],
@@ -71,10 +81,12 @@ def monte_carlo(samples: int, workers: int, keep: str, folder: Path, seed: int =
     config = toleranced_config(folder)
     started = time.perf_counter()
     plan = plan_sweep(SweepRequest(config, sample=samples, seed=seed, keep=keep, out=folder / "sweep"), BUNDLED_CONFIG)
-    planned = time.perf_counter()
+    planned, own_cpu = time.perf_counter(), time.process_time()
     with LocalPool(workers) as pool:
         result = run_sweep(plan, pool)
-        memory = [peak_memory_mb(pid) for pid in list(pool._pool.executor._processes or {})]
+        own_cpu = time.process_time() - own_cpu
+        pids = list(pool._pool.executor._processes or {})
+        memory, worker_cpu = [peak_memory_mb(pid) for pid in pids], [cpu_seconds(pid) for pid in pids]
     finished = time.perf_counter()
     with (plan.folder / "summary.csv").open(newline="") as handle:
         rows = list(csv.DictReader(handle))
@@ -88,6 +100,8 @@ def monte_carlo(samples: int, workers: int, keep: str, folder: Path, seed: int =
             "integration_total_s": sum(integration), "integration_median_s": statistics.median(integration),
             "integration_bound_cases_per_minute": 60.0 * workers * len(integration) / sum(integration),
             "overhead_share": 1.0 - sum(integration) / workers / sweep_s,
+            "worker_cpu_s": [c for c in worker_cpu if c is not None], "sweep_process_cpu_s": own_cpu,
+            "cpu_s_per_case": (sum(c for c in worker_cpu if c is not None) + own_cpu) / cases,
             "mb_per_case_file": statistics.mean(files) / 1e6 if files else 0.0,
             "mb_per_case_on_disk": on_disk / 1e6 / cases,
             "worker_peak_rss_mb": [m for m in memory if m is not None]}

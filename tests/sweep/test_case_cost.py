@@ -53,3 +53,29 @@ def test_a_case_looks_for_a_killed_worker_s_file_once(tmp_path, monkeypatch):
     task = next(t for t in tasks_of(sweep) if t.name != "ideal")
     assert worker.run_case(task).state == "complete"
     assert looked == [Path(task.output)]
+
+
+def turns_sample_by_sample(angle):
+    """full_turns' definition, one sample at a time: (ends, directions)."""
+    ends, directions, level = [], [], float(angle[0]) if len(angle) else 0.0
+    for i, value in enumerate(np.asarray(angle, dtype=float).tolist()):
+        while abs(value - level) >= 2 * np.pi:
+            direction = 1 if value > level else -1
+            level += direction * 2 * np.pi
+            ends.append(i)
+            directions.append(direction)
+    return ends, directions
+
+
+def test_the_turns_of_a_journal_path_are_those_of_a_sample_by_sample_count():
+    from clearsim.whirl import full_turns
+
+    rng = np.random.default_rng(7)
+    paths = [np.cumsum(rng.normal(0.0, 0.6, 3000)), np.cumsum(rng.normal(0.1, 0.05, 5000)),
+             np.round(np.cumsum(rng.normal(0.0, 1.0, 2000)) / np.pi) * np.pi,  # levels met exactly
+             (2 * np.pi / 37 * np.arange(4000)).astype(np.float32), np.zeros(0), np.array([1.0])]
+    for angle in paths:
+        turns = full_turns(angle)
+        ends, directions = turns_sample_by_sample(angle)
+        assert turns.ends.tolist() == ends and turns.directions.tolist() == directions
+    assert len(full_turns(paths[1]).ends) > 50

@@ -192,7 +192,7 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     histories `contents` names (CONTENTS). warn(text): a warning of the run as soon as it is seen (Run).
     keep(name): the datasets of the file to hold in memory too (RunReport.kept, when the file was written whole).
     adopt: first give the files a killed run left being written as `output` that name (adopt_abandoned); a caller
-    that has just done so passes False (each look lists the folder: 4 ms in a folder of 10 000 files).
+    that has just done so passes False (each look lists the folder: 5 ms in a folder of 10 000 files).
 
     Chunks are gathered and written at most every FLUSH_SECONDS of wall time (each HDF5 append
     costs ~0.4 ms per dataset, which for short runs cost more than the integration); whatever was
@@ -252,7 +252,8 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                     | _travel_attributes(system, writer) if run is not None else {}
                 readable = writer.finish(complete, status, final)
                 backup, identity, error = _give_its_name(writer, output, readable, error)
-    kept = pending.kept_histories(run) if keep is not None and identity is not None and not writer.broken else None
+    written_whole = identity is not None and not writer.broken and not isinstance(error, ResultWriteError)
+    kept = pending.kept_histories(run) if keep is not None and written_whole else None
     return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
                      warnings, identity, kept)
 
@@ -390,7 +391,8 @@ class _PendingChunks:
     def kept_histories(self, run: Run | None) -> Kept:
         """The kept datasets whole, the file's root attributes, and the episode tables' peaks where the file has the
         tables (written with the first samples)."""
-        data = {"attrs": dict(self.writer.attributes)} | {name: np.concatenate(parts) for name, parts in self.kept.items()}
+        data = {"attrs": dict(self.writer.attributes)}
+        data |= {name: np.concatenate(parts) for name, parts in self.kept.items()}
         peaks = run.statistics().peak_normal_force if run is not None and self.episodes else []
         return Kept(data, {name: float(peak) for name, peak in zip(self.system.clearance_joints, peaks)})
 
@@ -490,7 +492,7 @@ def _finite(values: np.ndarray) -> np.ndarray:
     return values[np.isfinite(values)]
 
 
-def _peak_contact_force(located, sampled: np.ndarray) -> float:
+def _peak_contact_force(located: float, sampled: np.ndarray) -> float:
     """The larger of the sampled peak and the peak located within every step (which samples can miss)."""
     tracked = float(located)
     return max(tracked if np.isfinite(tracked) else 0.0, float(np.max(_finite(sampled), initial=0.0)))

@@ -27,8 +27,8 @@ from clearsim.assembly.system import System, assemble
 from clearsim.errors import ClearsimError, InputError, SolverError, format_path
 from clearsim.io.files import adopt_abandoned, locate, partial_name, publish, same_file
 from clearsim.io.hdf5 import (
-    CHUNK_ROWS, NotAResultFile, ResultWriteError, ResultWriter, check_free_space, group_attribute, interrupts_deferred,
-    read_result, result_overview, write_failure,
+    CHUNK_ROWS, NotAResultFile, ResultWriteError, ResultWriter, as_read, check_free_space, group_attribute,
+    interrupts_deferred, read_result, result_overview, write_failure,
 )
 from clearsim.io.wear_results import archard_joints, wear_profile_tables
 from clearsim.model.loader import FAST_LOADER, LoadedMechanism, load_mechanism
@@ -100,6 +100,17 @@ def prepare(loaded: LoadedMechanism) -> System:
 
 
 @dataclass
+class Kept:
+    """What a written result file holds of the datasets run_to_file's `keep` names, kept in memory as it was written,
+    so that a reader of the file need not open it again (a sweep's case record): `data` in read_result's layout (the
+    root attributes, and each kept dataset as read back: float32 histories as float64) and each clearance joint's
+    episode table's `peak_normal_force_N` (absent with the table)."""
+
+    data: dict
+    episode_peaks: dict[str, float]
+
+
+@dataclass
 class RunReport:
     destination: Path  # the -o of the run
     backup: Path | None
@@ -109,6 +120,7 @@ class RunReport:
     error: Exception | None = None
     warnings: list[str] = field(default_factory=list)  # also the result file's `warnings` attribute, a line each
     identity: os.stat_result | None = None  # of the file written, once it has its name
+    kept: Kept | None = None  # run_to_file(keep=…): what the file holds of those datasets, from memory
 
     @property
     def output(self) -> Path:
@@ -154,8 +166,8 @@ def _travel_attributes(system: System, writer: ResultWriter) -> dict:
     return {"travel_figures": json.dumps({"sensor": spec.sensor} | figures)}
 
 
-def _write_episodes(writer: ResultWriter, system: System, run: Run, sample_episodes: np.ndarray) -> None:
-    """Episode tables per clearance joint and the final contact modes of every sample."""
+def _write_episodes(writer: ResultWriter, system: System, run: Run, sample_episodes: np.ndarray) -> np.ndarray:
+    """Episode tables per clearance joint and the final contact modes of every sample (returned, (S, nc))."""
     log = run.episode_log()
     kinds = classify_episodes(system, log)
     modes = sample_modes(kinds, sample_episodes)
@@ -169,13 +181,18 @@ def _write_episodes(writer: ResultWriter, system: System, run: Run, sample_episo
             "effective_mass": (log.effective_mass[mine], "kg"),
             "kind": (kinds[mine], "1 impact, 2 continuous contact")},
             {"peak_normal_force_N": float(stats.peak_normal_force[k])})
+    return modes
 
 
 def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                 progress: Callable[[float], None] | None = None, contents: str = "all",
-                warn: Callable[[str], None] | None = None) -> RunReport:
+                warn: Callable[[str], None] | None = None, keep: Callable[[str], bool] | None = None,
+                adopt: bool = True) -> RunReport:
     """Simulate and write as it goes; interruption or failure still leaves a flagged, readable file with the
     histories `contents` names (CONTENTS). warn(text): a warning of the run as soon as it is seen (Run).
+    keep(name): the datasets of the file to hold in memory too (RunReport.kept, when the file was written whole).
+    adopt: first give the files a killed run left being written as `output` that name (adopt_abandoned); a caller
+    that has just done so passes False (each look lists the folder: 5 ms in a folder of 10 000 files).
 
     Chunks are gathered and written at most every FLUSH_SECONDS of wall time (each HDF5 append
     costs ~0.4 ms per dataset, which for short runs cost more than the integration); whatever was
@@ -184,7 +201,8 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
     output = Path(output)
     needed = result_file_bytes(system, contents)
     check_free_space(output, needed)
-    adopt_abandoned(output)  # a killed run's file: under its name, so that this run keeps it as previous
+    if adopt:
+        adopt_abandoned(output)  # a killed run's file: under its name, so that this run keeps it as previous
     partial = partial_name(output)  # its own file until it is finished: runs with the same -o never meet
     run = None  # made inside the try: loading the compiled kernels can take seconds, and may be interrupted
     episodes, status, complete, error = [], "complete", True, None
@@ -197,7 +215,7 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
         partial.unlink(missing_ok=True)
         raise write_failure(output, exc, needed) from None
     with np.errstate(all="ignore"), writer:
-        pending = _PendingChunks(writer, episodes, system, CONTENTS[contents])
+        pending = _PendingChunks(writer, episodes, system, CONTENTS[contents], keep)
         try:
             run = Run(system, warn)
             for chunk in run.chunks(progress):
@@ -217,7 +235,7 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                     if not writer.broken:
                         pending.flush()
                         if episodes:
-                            _write_episodes(writer, system, run, np.concatenate(episodes))
+                            pending.final_modes(_write_episodes(writer, system, run, np.concatenate(episodes)))
                         if run is not None:
                             for group, table in wear_profile_tables(system, run.y, run.time).items():
                                 writer.write_table(group, *table)  # the accumulated wear profiles, at the end
@@ -234,8 +252,10 @@ def run_to_file(system: System, loaded: LoadedMechanism, output: Path,
                     | _travel_attributes(system, writer) if run is not None else {}
                 readable = writer.finish(complete, status, final)
                 backup, identity, error = _give_its_name(writer, output, readable, error)
+    written_whole = identity is not None and not writer.broken and not isinstance(error, ResultWriteError)
+    kept = pending.kept_histories(run) if keep is not None and written_whole else None
     return RunReport(output, backup, complete, status, run.statistics() if run is not None else Statistics(), error,
-                     warnings, identity)
+                     warnings, identity, kept)
 
 
 def _give_its_name(writer: ResultWriter, output: Path, readable: bool, error: Exception | None):
@@ -322,8 +342,11 @@ class _PendingChunks:
     episodes (once per flush, not per chunk: the per-call cost of deriving ~40 datasets was a fifth of a short
     run's wall time). The contact modes written here are provisional; the final ones replace them at the end."""
 
-    def __init__(self, writer: ResultWriter, episodes: list, system: System, wanted: Callable[[str], bool]):
+    def __init__(self, writer: ResultWriter, episodes: list, system: System, wanted: Callable[[str], bool],
+                 keep: Callable[[str], bool] | None = None):
         self.writer, self.episodes, self.system, self.wanted = writer, episodes, system, wanted
+        self.keep = keep or (lambda name: False)
+        self.kept: dict[str, list[np.ndarray]] = {}  # dataset → the parts written, as read back (Kept)
         self.run: Run | None = None
         self.items: list = []
         self.initial_energy: float | None = None
@@ -348,6 +371,9 @@ class _PendingChunks:
             self.system, chunk, provisional, self.initial_energy).items() if self.wanted(name)})
         with interrupts_deferred():  # the samples and their episodes are written whole, or not at all
             self.writer.append(chunk.times, outputs)
+            for name, values in (("time", chunk.times), *((name, values) for name, (values, _) in outputs.items())):
+                if self.keep(name):
+                    self.kept.setdefault(name, []).append(as_read(np.ascontiguousarray(values)))
             self.episodes.append(chunk.episodes)
             self.times.append(chunk.times)
             arrays = self.system.arrays
@@ -355,6 +381,20 @@ class _PendingChunks:
                                             chunk.states, chunk.contact[:, :, [C_ECC_X, C_ECC_Y]]))
         self.items.clear()
         self.written_at = time.perf_counter()
+
+    def final_modes(self, modes: np.ndarray) -> None:
+        """The final contact modes of every sample written (_write_episodes) in place of the provisional ones kept."""
+        for k, name in enumerate(self.system.clearance_joints):
+            if f"joints/{name}/mode" in self.kept:
+                self.kept[f"joints/{name}/mode"] = [modes[:, k]]
+
+    def kept_histories(self, run: Run | None) -> Kept:
+        """The kept datasets whole, the file's root attributes, and the episode tables' peaks where the file has the
+        tables (written with the first samples)."""
+        data = {"attrs": dict(self.writer.attributes)}
+        data |= {name: np.concatenate(parts) for name, parts in self.kept.items()}
+        peaks = run.statistics().peak_normal_force if run is not None and self.episodes else []
+        return Kept(data, {name: float(peak) for name, peak in zip(self.system.clearance_joints, peaks)})
 
     def law_range_warnings(self) -> list[str]:
         """Each clearance joint's elastic law used outside its range, at the deepest penetration sampled
@@ -409,7 +449,18 @@ def summarize(path: Path, data: dict | None = None) -> Summary:
     """The figures `clearsim run` prints, read back from a result file (or from `data`, read_result of it with at
     least the datasets of `summary_dataset`)."""
     data = read_result(path, summary_dataset) if data is None else data
-    output = _output_sensors(data["attrs"]["config_yaml"])
+    peaks = {joint: group_attribute(path, f"joints/{joint}/episodes", "peak_normal_force_N", 0.0)
+             for joint in _clearance_joints(data["attrs"])}
+    return summary_of(data, _output_sensors(data["attrs"]["config_yaml"]), peaks)
+
+
+def _clearance_joints(attributes: dict) -> list[str]:
+    return [j for j in str(attributes.get("clearance_joints", "")).split(",") if j]
+
+
+def summary_of(data: dict, output: dict, episode_peaks: dict[str, float]) -> Summary:
+    """summarize's figures from `data` (read_result's layout, or run_to_file's Kept), the file's `output:` block
+    (role → sensor name) and its episode tables' `peak_normal_force_N` (joint → N; absent: no table)."""
     peak = {}
     for role in ("velocity", "acceleration"):
         name = output.get(role)
@@ -419,8 +470,9 @@ def summarize(path: Path, data: dict | None = None) -> Summary:
         name, sampled = peak["acceleration"]
         tracked = float(data["attrs"].get("peak_output_acceleration", 0.0))
         peak["acceleration"] = (name, max(sampled, tracked if np.isfinite(tracked) else 0.0))
-    joints = [j for j in str(data["attrs"].get("clearance_joints", "")).split(",") if j]
-    forces = {j: _peak_contact_force(path, j, data.get(f"joints/{j}/normal_force", NO_SAMPLES)) for j in joints}
+    joints = _clearance_joints(data["attrs"])
+    forces = {j: _peak_contact_force(episode_peaks.get(j, 0.0), data.get(f"joints/{j}/normal_force", NO_SAMPLES))
+              for j in joints}
     shares = {}
     for j in joints:
         mode = data.get(f"joints/{j}/mode", NO_SAMPLES)  # none in a run stopped before its first sample
@@ -440,9 +492,9 @@ def _finite(values: np.ndarray) -> np.ndarray:
     return values[np.isfinite(values)]
 
 
-def _peak_contact_force(path: Path, joint: str, sampled: np.ndarray) -> float:
+def _peak_contact_force(located: float, sampled: np.ndarray) -> float:
     """The larger of the sampled peak and the peak located within every step (which samples can miss)."""
-    tracked = float(group_attribute(path, f"joints/{joint}/episodes", "peak_normal_force_N", 0.0))
+    tracked = float(located)
     return max(tracked if np.isfinite(tracked) else 0.0, float(np.max(_finite(sampled), initial=0.0)))
 
 

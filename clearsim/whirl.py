@@ -67,14 +67,18 @@ class Turns:
 def full_turns(angle: np.ndarray) -> Turns:
     """A turn completes when φ is 2π past the level where the previous one completed (at first: φ at the first
     sample), in either direction; it began at the last sample before at which φ was at or behind that level."""
+    angle = np.asarray(angle, dtype=float)
     ends, directions = [], []
     level = float(angle[0]) if len(angle) else 0.0
-    for i, value in enumerate(angle.tolist()):
+    i = _turn_away(angle, level, 0)
+    while i < len(angle):
+        value = float(angle[i])
         while abs(value - level) >= 2 * np.pi:
             direction = 1 if value > level else -1
             level += direction * 2 * np.pi
             ends.append(i)
             directions.append(direction)
+        i = _turn_away(angle, level, i + 1)
     starts, previous = [], 0
     for end, direction in zip(ends, directions):
         # from the sample before the previous turn completed, φ was behind this turn's level (or the run began)
@@ -83,6 +87,20 @@ def full_turns(angle: np.ndarray) -> Turns:
         starts.append(searched + int(behind[-1]) if len(behind) else searched)
         previous = end
     return Turns(np.asarray(starts, dtype=int), np.asarray(ends, dtype=int), np.asarray(directions, dtype=int))
+
+
+TURN_SEARCH = 256  # samples compared with the level at a time (a whirl's turn takes ~50 samples at 100 kHz)
+
+
+def _turn_away(angle: np.ndarray, level: float, start: int) -> int:
+    """The first sample from `start` at which φ is 2π or more from `level` (len(angle): none): the comparison
+    full_turns makes at each sample, made TURN_SEARCH samples at a time (one at a time in Python took 1.3 ms a
+    joint of a UHV run)."""
+    for first in range(start, len(angle), TURN_SEARCH):
+        away = np.flatnonzero(np.abs(angle[first:first + TURN_SEARCH] - level) >= 2 * np.pi)
+        if len(away):
+            return first + int(away[0])
+    return len(angle)
 
 
 def whirl_windows(time: np.ndarray, angle: np.ndarray, relative_angle: np.ndarray, eccentricity_ratio: np.ndarray,

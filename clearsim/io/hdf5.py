@@ -182,6 +182,7 @@ class ResultWriter:
 
     def __init__(self, path: Path, config_yaml: str, attributes: dict | None = None):
         self.path = Path(path)
+        self.attributes: dict = {}  # the root attributes written so far, as written
         self.rows = 0
         self.created: set[str] = set()
         self.broken = False
@@ -191,7 +192,7 @@ class ResultWriter:
             try:
                 with self._writing():
                     self.file = h5py.File(self.path, "w", rdcc_nbytes=0)
-                    self.file.attrs.update({
+                    self._set_attributes({
                         "clearsim_version": __version__,
                         "created": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
                         "config_yaml": config_yaml, "complete": False, "status": "running"} | (attributes or {}))
@@ -268,13 +269,17 @@ class ResultWriter:
         if not self.broken:
             try:
                 with self._writing():
-                    self.file.attrs.update(final)
+                    self._set_attributes(final)
                     self.file.close()
                 return True
             except WriteFailed:
                 pass
         self._close_quietly()
         return flag_after_failure(self.path, final)
+
+    def _set_attributes(self, attributes: dict) -> None:
+        self.file.attrs.update(attributes)
+        self.attributes |= attributes
 
     def _close_quietly(self) -> None:
         if self.file is not None and self.file.id.valid:
@@ -326,14 +331,19 @@ def read_result(path: Path, wanted: Callable[[str], bool] | None = None) -> dict
 
         def keep(name, node):
             if isinstance(node, h5py.Dataset):
-                values = node[()]  # a float32 history is handed on as float64, as older files stored it
-                out[name] = values.astype(np.float64) if values.dtype == np.float32 else values
+                out[name] = as_read(node[()])
 
         if wanted is None:
             handle.visititems(keep)
         else:  # by name first: an h5py object for each of the file's groups and datasets costs more than the reading
             handle.visit(lambda name: keep(name, handle[name]) if wanted(name) else None)
         return out
+
+
+def as_read(values: np.ndarray) -> np.ndarray:
+    """A dataset's stored values as read_result hands them on: a float32 history as float64, as older files stored
+    it."""
+    return values.astype(np.float64) if values.dtype == np.float32 else values
 
 
 def read_attributes(path: Path) -> dict:

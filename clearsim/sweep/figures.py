@@ -1,8 +1,8 @@
 """Figures of merit of a case, read against its ideal reference (definitions: docs/sweeps.md).
 
-`read_record` runs where the case ran (a pool or Dask worker) and keeps only what the summary
-needs; the figures that compare with the ideal case are taken as soon as both records are in (`settled`), and
-the case's histories dropped then.
+`read_record` (or `kept_record`, from what the run kept in memory of the file it wrote) runs where the case ran (a
+pool or Dask worker) and keeps only what the summary needs; the figures that compare with the ideal case are taken
+as soon as both records are in (`settled`), and the case's histories dropped then.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from clearsim.io.hdf5 import read_result
-from clearsim.runner import summarize, summary_dataset
+from clearsim.runner import Kept, summarize, summary_dataset, summary_of
 
 NAN = math.nan
 NO_SAMPLES = np.empty(0)
@@ -66,7 +66,17 @@ def record_dataset(output):
 def read_record(path: Path, output) -> CaseRecord:
     """The record of a result file; `output` is the mechanism's OutputSensors."""
     data = read_result(path, record_dataset(output))
-    summary = summarize(path, data)
+    return _record(data, summarize(path, data), output)
+
+
+def kept_record(kept: Kept, roles: dict, output) -> CaseRecord:
+    """read_record of the file a run has just written, from what it kept in memory of it (run_to_file with
+    keep=record_dataset(output)): `roles` is the file's `output:` block (role → sensor name), `output` the mechanism's
+    OutputSensors. The same record, without opening the file again (8 ms of a UHV case's 270)."""
+    return _record(kept.data, summary_of(kept.data, roles, kept.episode_peaks), output)
+
+
+def _record(data: dict, summary, output) -> CaseRecord:
     attrs = data["attrs"]
     contact = {joint: (force, *summary.contact_time_share[joint]) for joint, force in summary.peak_contact_force.items()}
     return CaseRecord(

@@ -21,7 +21,7 @@ from clearsim.io.hdf5 import NotAResultFile, ResultWriteError, keep_as_previous,
 from clearsim.model.loader import load_mechanism_text
 from clearsim.process import exit_without_final_collection
 from clearsim.runner import contents_serve, prepare, run_to_file
-from clearsim.sweep.figures import CaseRecord, read_record
+from clearsim.sweep.figures import CaseRecord, kept_record, read_record, record_dataset
 
 COMPLETE, FAILED, INTERRUPTED, NOT_RUN = "complete", "failed", "interrupted", "not run"
 
@@ -115,12 +115,17 @@ def _attempt(task: CaseTask) -> CaseOutcome:
     if (reused := _reused(task, loaded)) is not None:
         return reused
     system = prepare(loaded)
-    report = run_to_file(system, loaded, output, contents=task.contents)
+    # the folder was looked at for a killed worker's file just now (_reused); the record's histories kept as written
+    report = run_to_file(system, loaded, output, contents=task.contents, keep=record_dataset(output_sensors),
+                         adopt=False)
     if isinstance(report.error, KeyboardInterrupt):
         raise KeyboardInterrupt
     if isinstance(report.error, ResultWriteError):
         raise report.error  # a failed case, with the reason; its file may not be readable
-    return _outcome(task.name, output, output_sensors, ran=True)
+    if report.kept is None:  # the file could not be written whole: what it holds is what counts
+        return _outcome(task.name, output, output_sensors, ran=True)
+    roles = dict(loaded.document.get("output") or {})  # as the file's config_yaml has them
+    return _outcome_of(task.name, kept_record(report.kept, roles, output_sensors), ran=True)
 
 
 def load_case(task: CaseTask):
@@ -163,7 +168,10 @@ def finished_outcome(task: CaseTask) -> CaseOutcome | None:
 
 
 def _outcome(name: str, output: Path, output_sensors, ran: bool) -> CaseOutcome:
-    record = read_record(output, output_sensors)
+    return _outcome_of(name, read_record(output, output_sensors), ran)
+
+
+def _outcome_of(name: str, record: CaseRecord, ran: bool) -> CaseOutcome:
     if record.complete:
         return CaseOutcome(name, COMPLETE, ran, "", record)
     error = record.status.removeprefix("failed: ")

@@ -110,9 +110,17 @@ def cache_is_cold() -> bool:
 
 
 def not_cached(kernel) -> bool:
-    """No compiled `kernel` (a cached numba dispatcher) in the kernel cache: numba's index file for it is missing."""
-    index = getattr(getattr(getattr(kernel, "_cache", None), "_cache_file", None), "_index_path", None)
-    return index is not None and not Path(index).exists()
+    """No compiled `kernel` (a cached numba dispatcher) in the kernel cache that numba would load: its index file is
+    missing, or numba reads it as empty (written by another numba version, or for other sources of the kernel: numba
+    then compiles it again, as on an empty cache)."""
+    cache_file = getattr(getattr(kernel, "_cache", None), "_cache_file", None)
+    return cache_file is not None and not cache_file._load_index()
+
+
+def compilations(kernels) -> int:
+    """How many times numba has compiled these kernels (numba dispatchers) in this process: each time it did not find
+    the kernel in memory nor load it from the kernel cache (numba's cache misses)."""
+    return sum(sum(kernel.stats.cache_misses.values()) for kernel in kernels)
 
 
 def _cores() -> int:

@@ -34,6 +34,7 @@ from numba.core import config
 
 from clearsim.assembly.arrays import KernelArraysType, blas_hidden
 from clearsim.assembly.dynamics import dynamics_type, films_type
+from clearsim.physics.wear import BORE_POINT_TYPE
 from clearsim.solver.integrator import DOPRI5, addressed_kernels, advance
 
 LOCK_NAME = "compile-ahead.lock"
@@ -86,9 +87,10 @@ _helper: subprocess.Popen | None = None
 
 
 def system_type():
-    """The numba type of every system's KernelArrays (one type for all mechanisms)."""
+    """The numba type of every system's KernelArrays (one type for all mechanisms: the arrays, and the worn bores'
+    nearest point by address, arrays.KERNEL_FIELDS)."""
     return KernelArraysType([(name, typeof(np.zeros((0,) * ndim, dtype))) for name, (dtype, ndim)
-                             in FIELD_LAYOUT.items()])
+                             in FIELD_LAYOUT.items()] + [("bore_point", BORE_POINT_TYPE)])
 
 
 def kernels_ahead():

@@ -18,10 +18,11 @@ from collections import namedtuple
 from contextlib import contextmanager
 
 import numpy as np
-from numba import njit, types
+from numba import njit, typeof, types
 from numba.experimental import structref
 
 from clearsim import numba_inlining
+from clearsim.physics.wear import BORE_POINT_TYPE, bore_point_kernel
 
 numba_inlining.install()  # before any kernel compiles: numba's inliner copies each callee's IR once, not per block
 
@@ -146,12 +147,16 @@ WORKSPACE_FIELDS = [
 ]
 
 
-structref.define_proxy(KernelArrays, KernelArraysType, list(SystemArrays._fields) + WORKSPACE_FIELDS)
+# and the kernel that finds a worn bore's nearest point, called by address (wear.BORE_POINT_TYPE): the worn-bore
+# geometry compiles as one library of its own, not linked into (and optimised again in) every kernel that reaches a
+# clearance joint's kinematics, and only for a model with a worn bore (wear.bore_point_kernel)
+KERNEL_FIELDS = list(SystemArrays._fields) + WORKSPACE_FIELDS + ["bore_point"]
+structref.define_proxy(KernelArrays, KernelArraysType, KERNEL_FIELDS)
 
 
 @njit(cache=True)
-def _pack(fields):
-    return KernelArrays(*fields)
+def _pack(fields, bore_point):
+    return KernelArrays(*fields, bore_point)
 
 
 def mass_diagonal(arrays: SystemArrays) -> np.ndarray:
@@ -180,20 +185,27 @@ def for_kernels(arrays: SystemArrays) -> KernelArrays:
     """The arrays as every compiled kernel takes them (one compiled specialisation for all callers), with the
     scratch of their solves."""
     fields = tuple(arrays) + _workspace(arrays)
+    bore_point = bore_point_kernel(arrays.wear_harmonics)
     if not _numba_target_ready:
-        return _first_pack(fields)
-    return _pack(fields)
+        return _first_pack(fields, bore_point)
+    return _packed(fields, bore_point)
+
+
+def _packed(fields, bore_point) -> KernelArrays:
+    """_pack compiled (or loaded) for the field `bore_point` typed by its function type, not as the kernel given, so
+    that every model's KernelArrays has one type whichever kernel it holds."""
+    return _pack.compile((typeof(fields), BORE_POINT_TYPE))(fields, bore_point)
 
 
 _numba_target_ready = False
 
 
-def _first_pack(fields) -> KernelArrays:
+def _first_pack(fields, bore_point) -> KernelArrays:
     """_pack, the process's first kernel call, with scipy's BLAS hidden from numba (`blas_hidden`)."""
     global _numba_target_ready
     _numba_target_ready = True
     with blas_hidden():
-        return _pack(fields)
+        return _packed(fields, bore_point)
 
 
 @contextmanager

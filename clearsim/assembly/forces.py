@@ -33,7 +33,7 @@ from clearsim.physics.contact import damped_force
 from clearsim.physics.cylindrical import law_force, law_state
 from clearsim.physics.friction import STICK_EXACT, friction_coefficient, sliding_coefficient
 from clearsim.physics.lubrication import film_force, film_torque, line_of_centres
-from clearsim.physics.wear import add_band_rates, band_half_angle, bore_curvature_radius, nearest_bore_point
+from clearsim.physics.wear import add_band_rates, band_half_angle, bore_curvature_radius
 
 # modes of a clearance joint, constant within a step. CONTACT is any contact of a smooth friction
 # law, and sliding along +t under an exact-stick law; STICK and SLIDE_BACK (sliding along −t)
@@ -83,7 +83,7 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
     wb = body_rates(qd, bearing)[2]
     c, s = np.cos(angle), np.sin(angle)
     local_x, local_y = c * ex + s * ey, -s * ex + c * ey
-    _, rx, ry, tangent_x, tangent_y, curvature = nearest_bore_point(
+    _, rx, ry, tangent_x, tangent_y, curvature = system.bore_point(  # wear.nearest_bore_point, by address
         system.wear_profile[k], system.wear_harmonics[k], system.wear_depth_range[k], system.wear_bounds[k, WEAR_REACH],
         system.wear_bounds[k, WEAR_INNERMOST], p[CL_BEARING_RADIUS], local_x, local_y)
     gap_x, gap_y = rx - local_x, ry - local_y

@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
 
 SAFEGUARDED_ITERATIONS = 60  # Newton converges quadratically (a step below NEWTON_TOLERANCE ends it); a bisection
 # step, taken when Newton would leave its bracket of 2π/(8M) either side, halves it (one below 1e-15 rad ends it)
@@ -108,6 +108,26 @@ def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, b
             theta = searched
     rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
     return theta, rx, ry, tx, ty, second
+
+
+# nearest_bore_point's type as the kernels call it by address (KernelArrays.bore_point, assembly/arrays.py): a row
+# of wear_profile, the harmonics, depth range, reach, innermost radius, R_B, e_x, e_y -> (θ*, r_x, r_y, t_x, t_y, ρ'')
+BORE_POINT_TYPE = types.FunctionType(types.UniTuple(types.float64, 6)(
+    types.float64[::1], types.int64, types.float64, types.float64, types.float64, types.float64, types.float64,
+    types.float64))
+
+
+@njit(cache=True)
+def no_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing_radius, ex, ey):
+    """nearest_bore_point's stand-in for a model without worn bores, of the same type and never called (its kernels
+    reach the worn-bore geometry only for a joint with harmonics > 0): such a model does not compile that geometry."""
+    return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+def bore_point_kernel(harmonics: np.ndarray):
+    """The kernel that finds a worn bore's nearest point for a model whose joints have these wear harmonics:
+    nearest_bore_point where a joint has a worn bore, else its stand-in (no_bore_point)."""
+    return nearest_bore_point if np.any(harmonics > 0) else no_bore_point
 
 
 @njit(cache=True, inline="always")

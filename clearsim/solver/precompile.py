@@ -34,6 +34,7 @@ from numba.core import config
 
 from clearsim.assembly.arrays import KernelArraysType, blas_hidden
 from clearsim.assembly.dynamics import dynamics_type, films_type
+from clearsim.physics.wear import BORE_POINT_TYPE
 from clearsim.solver.integrator import DOPRI5, addressed_kernels, advance
 
 LOCK_NAME = "compile-ahead.lock"
@@ -86,9 +87,10 @@ _helper: subprocess.Popen | None = None
 
 
 def system_type():
-    """The numba type of every system's KernelArrays (one type for all mechanisms)."""
+    """The numba type of every system's KernelArrays (one type for all mechanisms: the arrays, and the worn bores'
+    nearest point by address, arrays.KERNEL_FIELDS)."""
     return KernelArraysType([(name, typeof(np.zeros((0,) * ndim, dtype))) for name, (dtype, ndim)
-                             in FIELD_LAYOUT.items()])
+                             in FIELD_LAYOUT.items()] + [("bore_point", BORE_POINT_TYPE)])
 
 
 def kernels_ahead():
@@ -110,9 +112,17 @@ def cache_is_cold() -> bool:
 
 
 def not_cached(kernel) -> bool:
-    """No compiled `kernel` (a cached numba dispatcher) in the kernel cache: numba's index file for it is missing."""
-    index = getattr(getattr(getattr(kernel, "_cache", None), "_cache_file", None), "_index_path", None)
-    return index is not None and not Path(index).exists()
+    """No compiled `kernel` (a cached numba dispatcher) in the kernel cache that numba would load: its index file is
+    missing, or numba reads it as empty (written by another numba version, or for other sources of the kernel: numba
+    then compiles it again, as on an empty cache)."""
+    cache_file = getattr(getattr(kernel, "_cache", None), "_cache_file", None)
+    return cache_file is not None and not cache_file._load_index()
+
+
+def compilations(kernels) -> int:
+    """How many times numba has compiled these kernels (numba dispatchers) in this process: each time it did not find
+    the kernel in memory nor load it from the kernel cache (numba's cache misses)."""
+    return sum(sum(kernel.stats.cache_misses.values()) for kernel in kernels)
 
 
 def _cores() -> int:

@@ -74,7 +74,7 @@ class Statistics:
     max_violation: float = 0.0
     wall_time: float = 0.0  # s in the compiled loop, without its first call (below)
     kernel_time: float = 0.0  # s of the loop's first call in this run: loading it, or on an empty cache compiling it
-    kernels_compiled: bool = False  # the kernel cache held no compiled loop when the run started
+    kernels_compiled: bool = False  # numba compiled the loop, or a kernel it takes by address, for its first call
     peak_normal_force: np.ndarray = field(default_factory=lambda: np.zeros(0))
     peak_output_acceleration: float = 0.0  # |output.acceleration| at every step's end (0: no such sensor)
     tolerance_over_penetration: float = 0.0  # largest over the contact onsets (docs/model.md §4)
@@ -250,10 +250,12 @@ class Run:
         # compiled rhs from Python instead would load a second copy of the dynamics (docs/performance.md)
         self.wall_time = 0.0
         self.kernel_time = 0.0
-        # the loop, or a kernel it takes by address for this method and model (integrator.addressed: the Rosenbrock
-        # step, the oil films' dynamics), is not in the cache
-        self.kernels_compiled = precompile.cache_is_cold() or any(
-            precompile.not_cached(kernel) for kernel in ig.addressed(int(self.ints[ig.I_METHOD]), self.lubricated))
+        # the loop and the kernels it takes by address for this method and model (integrator.addressed: the
+        # Rosenbrock step, the oil films' dynamics): whether numba compiled any of them for the loop's first call
+        # (rather than loading it from the cache, or finding it in memory) is known once that call has returned
+        self.loop_kernels = (ig.advance, *ig.addressed(int(self.ints[ig.I_METHOD]), self.lubricated))
+        self.compilations_before = precompile.compilations(self.loop_kernels)
+        self.kernels_compiled = False
         self.coordinate_count = n
         self.watched = (0, 0.0)  # tried steps and time where the stretch being watched began (judge_pace)
         self.pace_warnings: list[str] = []
@@ -309,6 +311,7 @@ class Run:
         loop(*arguments)
         if self.ints[ig.I_STATUS] == ig.FIRST_STEP:  # the first call: loads (or compiles) the loop, one rhs
             self.kernel_time += clock.perf_counter() - started
+            self.kernels_compiled = precompile.compilations(self.loop_kernels) > self.compilations_before
             precompile.reap_helper()
         else:
             self.wall_time += clock.perf_counter() - started

@@ -24,6 +24,8 @@ ROOT = Path(__file__).resolve().parents[2]
 CRANK = BUNDLED_CONFIG.parent / "slider_crank_flores.yaml"
 LUBRICATED = ("defaults.lubrication.viscosity=0.1Pa*s", "defaults.lubrication.length=50mm", "solver.t_end=0.2ms")
 FILM_KERNELS = ("clearsim.assembly.forces.film_forces", "clearsim.physics.lubrication.film_force")
+BORE_KERNELS = ("clearsim.physics.wear.nearest_bore_point", "clearsim.physics.wear.refined_foot")
+WORN = ("joints.J.wear={profile: {cos: [0.03 mm, 0, 0.02 mm], sin: [0.005 mm]}, wall: 2 mm}", "solver.t_end=0.2ms")
 SCRIPT = """
 import collections, sys
 from numba.core import event
@@ -72,6 +74,7 @@ def test_helper_then_run_compile_every_kernel_once_with_the_same_results(tmp_pat
     step = "clearsim.solver.rosenbrock.attempt"
     assert step not in by_helper and step not in by_run  # an explicit run compiles no Rosenbrock step (its stand-in)
     assert [name for name in FILM_KERNELS if name in by_helper or name in by_run] == []  # a dry model: no film kernel
+    assert [name for name in BORE_KERNELS if name in by_helper or name in by_run] == []  # no worn bore: no geometry
     _, by_implicit = _compiled(env, CRANK, tmp_path / "implicit.h5", "solver.method=rosenbrock")
     assert by_implicit.get(step) == 1 and "clearsim.solver.integrator.advance" not in by_implicit  # the same loop
     with h5py.File(tmp_path / "implicit.h5") as implicit:
@@ -82,6 +85,9 @@ def test_helper_then_run_compile_every_kernel_once_with_the_same_results(tmp_pat
     assert "clearsim.solver.integrator.advance" not in by_lubricated  # in the same loop
     with h5py.File(tmp_path / "lubricated.h5") as lubricated:
         assert bool(lubricated.attrs["kernels_compiled"])
+    _, by_worn = _compiled(env, BUNDLED_CONFIG, tmp_path / "worn.h5", *WORN)
+    assert all(by_worn.get(name) == 1 for name in BORE_KERNELS)  # a model with a worn bore compiles its geometry
+    assert "clearsim.solver.integrator.advance" not in by_worn  # for the same loop, which calls it by address
 
     simulate_config(BUNDLED_CONFIG, ["solver.t_end=1ms"], tmp_path / "suite-cache-filled.h5")  # compiles if cold
     simulate_config(BUNDLED_CONFIG, ["solver.t_end=1ms"], tmp_path / "suite-cache.h5")

@@ -2,6 +2,7 @@
 one at a time per cache, and never when switched off (clearsim/solver/precompile.py)."""
 
 import fcntl
+import importlib.util
 import inspect
 import os
 import subprocess
@@ -71,6 +72,47 @@ def test_the_cache_is_cold_until_a_run_has_compiled_advance(tmp_path):
     assert empty.stdout.strip() == "True", empty.stderr
     simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")  # this process's cache now holds `advance`
     assert not precompile.cache_is_cold()
+
+
+TINY_KERNEL = """
+from numba import njit
+
+
+@njit(cache=True)
+def doubled(x):
+    return 2.0 * x
+"""
+
+
+def _tiny_kernel(source):
+    """The kernel of `source` as a fresh numba dispatcher (the module imported anew), as a new process has it."""
+    spec = importlib.util.spec_from_file_location("tiny_kernel", source)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.doubled
+
+
+def test_a_kernel_whose_cache_index_is_stale_counts_as_compiled_not_as_loaded(tmp_path, monkeypatch):
+    """numba compiles again a kernel whose index was written for other sources (an edit, a `git pull` on an
+    editable install with NUMBA_CACHE_DIR set): the index file is there, but the kernel is not cached, and the
+    compilation is counted, as on an empty cache; a fresh index is loaded and counts none."""
+    # read when a cached kernel is defined; numba's compiler reloads it from the variable when the variable changes
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(config, "CACHE_DIR", str(tmp_path / "cache"))
+    source = tmp_path / "tiny_kernel.py"
+    source.write_text(TINY_KERNEL)
+    first = _tiny_kernel(source)
+    assert precompile.not_cached(first)
+    assert first(1.5) == 3.0 and precompile.compilations([first]) == 1
+    loaded = _tiny_kernel(source)
+    assert not precompile.not_cached(loaded)
+    assert loaded(1.5) == 3.0 and precompile.compilations([loaded]) == 0
+    source.write_text(TINY_KERNEL + "# edited after the cache was written\n")
+    stale = _tiny_kernel(source)
+    assert os.path.exists(stale._cache._cache_file._index_path)
+    assert precompile.not_cached(stale)
+    assert stale(1.5) == 3.0 and precompile.compilations([stale]) == 1
+    assert precompile.compilations([first, loaded, stale]) == 2
 
 
 def test_a_second_helper_on_the_same_cache_compiles_nothing(tmp_path, monkeypatch):

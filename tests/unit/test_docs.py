@@ -96,3 +96,21 @@ def test_the_checks_find_what_they_look_for(tmp_path):
     assert len(history_lines(page)) == 2
     assert _slug("Sticking: `stick: exact` (default) or `smooth`") == "sticking-stick-exact-default-or-smooth"
     assert _slug("13. Key reference") == "13-key-reference"
+
+
+WEAR_EXAMPLE = re.compile(r"^    (wear: \{.*?\}\})\s*$", re.MULTILINE | re.DOTALL)
+
+
+def test_the_wear_block_of_the_contact_page_is_accepted_on_a_clearance_joint():
+    """The `wear:` example of model-contact.md, as printed, on the bundled breaker's joint A: a valid profile (depth ≥ 0
+    everywhere) and Archard block, not an input error."""
+    import yaml
+
+    from clearsim.model.loader import load_mechanism_text
+
+    example = yaml.safe_load(WEAR_EXAMPLE.search((DOCS / "model-contact.md").read_text(encoding="utf-8")).group(1))
+    document = yaml.safe_load((ROOT / "clearsim" / "configs" / "uhv_breaker.yaml").read_text(encoding="utf-8"))
+    joint = next(j for j in document["joints"] if j["name"] == "A")
+    joint["wear"] = example["wear"]
+    mechanism = load_mechanism_text(yaml.safe_dump(document)).mechanism
+    assert next(j for j in mechanism.joints if j.name == "A").wear.profile is not None

@@ -185,8 +185,8 @@ def _summary_table(report, summary) -> Table:
     table.add_row("steps (rejected)", f"{stats.steps} ({stats.rejected_steps})")
     table.add_row("contact events", f"{stats.contact_events}")
     table.add_row("wall time", f"{stats.wall_time:.3f} s (integration)")
-    table.add_row("compiled loop", f"{stats.kernel_time:.1f} s (compiled: not in the kernel cache)" if stats.kernels_compiled
-                  else f"{stats.kernel_time:.2f} s (from the cache)")
+    table.add_row("compiled loop", f"{stats.kernel_time:.1f} s (compiled: not in the kernel cache)"
+                  if stats.kernels_compiled else f"{stats.kernel_time:.2f} s (from the cache)")
     return table
 
 

@@ -65,6 +65,9 @@ ZOOM_MINIMA = 2  # zoom around the two lowest local minima of the profile
 SIGNIFICANCE = 10.0  # ΔBIC below −10: "very strong" evidence (Kass & Raftery 1995)
 TIE = 6.0  # BIC within 6 of the best: the data do not tell the two apart
 PROFILE_POINTS = 7  # points of the local parabola through the profile
+VERTEX_POINTS = 5  # the fewest runs of profile_vertex's refits (2 residual degrees of freedom)
+VERTEX_ITERATIONS = 8  # refits of profile_vertex at most
+VERTEX_TOLERANCE = 1e-4  # of the unit range: profile_vertex's vertex has settled when it moves less
 VISIBLE = 1.0  # |Δχ²| below 1 at both screening values: the sensors do not see the candidate
 RESONANCE_ROUNDS = 2  # rounds of frequency-matched values for a resonant candidate in screening
 ROUGH_ROUNDS = 2  # rounds of a rough candidate's window about its smoothed minimum
@@ -407,7 +410,9 @@ def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
     rough = [s for s in chosen if s.candidate.rough]
     for s in rough:
         s.windows = {band: (float(s.candidate.to_unit(lowest(s, band).value)), 1.0 / (SCAN_POINTS + 1)) for band in BANDS}
-    evaluate_points(evaluator, record, sensors, [(s, v) for s in smooth for v in low_band_values(s)], document)
+    screening_samples = record.low_band.effective_samples if record.low_band is not None else record.effective_samples
+    evaluate_points(evaluator, record, sensors, [(s, v) for s in smooth for v in low_band_values(s, screening_samples)],
+                    document)
     for round_ in range(max(len(ZOOM_ROUNDS), ROUGH_ROUNDS)):
         jobs = [(s, v) for s in smooth if round_ < len(ZOOM_ROUNDS) for v in _zoom(s, ZOOM_ROUNDS[round_])]
         jobs += [(s, v) for s in rough if round_ < ROUGH_ROUNDS for v in _window_values(s)]
@@ -415,7 +420,7 @@ def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
         for s in rough if round_ < ROUGH_ROUNDS else []:
             s.profiles = {band: _smoothed_minimum(s, *s.windows[band], band) for band in BANDS}
             s.windows = {band: (s.profiles[band][0], s.windows[band][1] / 2.0) for band in BANDS}
-    jobs = [(s, v) for s in smooth if (v := profile_vertex(s)) is not None]
+    jobs = [(s, v) for s in smooth if (v := profile_vertex(s, record.effective_samples)) is not None]
     jobs += [(s, float(s.candidate.from_unit(s.smoothed[0]))) for s in rough]
     evaluate_points(evaluator, record, sensors, jobs, document)
     for s in chosen:
@@ -456,11 +461,13 @@ def _smoothed_minimum(scored: Scored, centre: float, half: float, low_band: bool
     return float(units[lowest]), half
 
 
-def profile_vertex(scored: Scored, low_band: bool = False) -> float | None:
-    """Vertex of a parabola fitted (least squares) to χ² (of the comparison band, or of the screening band)
-    over the points near the best one, in the candidate's unit range: the minimum of the profile with the
-    chaotic scatter of single runs smoothed out. None when the local profile is not convex or the vertex
-    leaves the points' span."""
+def profile_vertex(scored: Scored, effective_samples: float, low_band: bool = False) -> float | None:
+    """Vertex of the profile's local parabola (χ² of the comparison band, or of the screening band, with
+    `effective_samples` its n_eff), in the candidate's unit range, refitted about each new vertex through fewer of the
+    runs nearest it (PROFILE_POINTS down to VERTEX_POINTS) until it moves by less than VERTEX_TOLERANCE
+    (VERTEX_ITERATIONS at most): the minimum of the profile with the chaotic scatter of single runs smoothed out, set
+    by the runs where the profile is locally quadratic. None when the first parabola is not convex or its vertex
+    leaves its runs' span; a later one that is not: the last vertex that was."""
     points = [p for p in scored.points if p.fit is not None]
     if len(points) < 4:
         return None
@@ -468,25 +475,53 @@ def profile_vertex(scored: Scored, low_band: bool = False) -> float | None:
     chi = np.array([p.chi_square_in(low_band) for p in points])
     if not np.all(np.isfinite(chi)):
         return None
+    vertex = None
     centre = float(units[np.argmin(chi)])
-    near = np.argsort(np.abs(units - centre))[:PROFILE_POINTS]
+    for count in vertex_point_counts():
+        moved = parabola_vertex(units, chi, centre, count, effective_samples)
+        if moved is None:
+            break
+        settled = vertex is not None and count == VERTEX_POINTS and abs(moved - vertex) < VERTEX_TOLERANCE
+        vertex = centre = moved
+        if settled:
+            break
+    return float(scored.candidate.from_unit(vertex)) if vertex is not None else None
+
+
+def vertex_point_counts() -> list[int]:
+    """The runs of each refit of profile_vertex: PROFILE_POINTS, one fewer each time down to VERTEX_POINTS, then
+    VERTEX_POINTS until VERTEX_ITERATIONS."""
+    return [max(PROFILE_POINTS - i, VERTEX_POINTS) for i in range(VERTEX_ITERATIONS)]
+
+
+def parabola_vertex(units: np.ndarray, chi: np.ndarray, centre: float, count: int,
+                    effective_samples: float) -> float | None:
+    """Vertex (unit range) of the parabola fitted to the `count` runs nearest `centre`, each weighted by 1/σ(χ²)
+    (chi_square_spread); None when it is not convex or the vertex leaves those runs' span."""
+    near = np.argsort(np.abs(units - centre))[:count]
     if np.ptp(units[near]) <= 0.0:
         return None
-    a, b, _ = np.polyfit(units[near] - centre, chi[near], 2)
+    a, b, _ = np.polyfit(units[near] - centre, chi[near], 2, w=1.0 / chi_square_spread(chi[near], effective_samples))
     if a <= 0.0:
         return None
     vertex = centre - b / (2.0 * a)
-    if not units[near].min() <= vertex <= units[near].max():
-        return None
-    return float(scored.candidate.from_unit(vertex))
+    return float(vertex) if units[near].min() <= vertex <= units[near].max() else None
 
 
-def low_band_values(scored: Scored) -> list[float]:
+def chi_square_spread(chi: np.ndarray, effective_samples: float) -> np.ndarray:
+    """σ(χ²) = √(2 n_eff + 4 λ), λ = max(χ² − n_eff, 0): the standard deviation of a non-central χ² of n_eff degrees of
+    freedom and non-centrality λ (Johnson, Kotz & Balakrishnan 1995, ch. 29), χ² of a run that misses the record by λ
+    beyond the noise."""
+    return np.sqrt(2.0 * effective_samples + 4.0 * np.maximum(chi - effective_samples, 0.0))
+
+
+def low_band_values(scored: Scored, effective_samples: float) -> list[float]:
     """Values about the minimum of the candidate's profile in the screening band, where the valley of the comparison
-    band lies when the scan missed it: the profile's vertex and ± a quarter of a scan step, and the midpoints between
-    the lowest run there and its neighbours on either side (`bracket_midpoints`)."""
+    band lies when the scan missed it: the profile's vertex (`effective_samples`: n_eff of the screening band) and ± a
+    quarter of a scan step, and the midpoints between the lowest run there and its neighbours on either side
+    (`bracket_midpoints`)."""
     centres = []
-    vertex = profile_vertex(scored, low_band=True)
+    vertex = profile_vertex(scored, effective_samples, low_band=True)
     if vertex is not None:
         centre, quarter = float(scored.candidate.to_unit(vertex)), 0.25 / (SCAN_POINTS + 1)
         centres = [centre - quarter, centre, centre + quarter]

@@ -19,6 +19,7 @@ CLEARANCE_B = Candidate("clearance", "B", "clearance", "m", 2e-6, 5e-4, True, 5e
 BUNDLED_B_SCAN = [(4.4014e-06, 413.85, 114.63), (9.6863e-06, 410.46, 110.52), (1.0481e-05, 431.69, 111.45),
                   (2.1317e-05, 420.24, 103.86), (4.6912e-05, 400.90, 92.17), (1.0324e-04, 615.14, 127.64),
                   (1.2574e-04, 806.18, 111.30), (2.2720e-04, 1118.92, 199.31)]
+SCREENING_SAMPLES = 50.0  # n_eff of its screening band, a stand-in: the vertex below is 27.5-27.9 µm for 50 … 300
 
 
 def _scored(candidate: Candidate, profile) -> Scored:
@@ -33,8 +34,8 @@ def test_the_valley_step_brackets_the_lowest_run_of_the_screening_band():
     vertex below 47 µm (the valley is steep on its far side), so the vertex's three values all missed it and every
     later zoom followed the lower minima; the midpoint of that bracket does not."""
     scored = _scored(CLEARANCE_B, BUNDLED_B_SCAN)
-    assert profile_vertex(scored, low_band=True) < 47e-6
-    values = low_band_values(scored)
+    assert profile_vertex(scored, SCREENING_SAMPLES, low_band=True) < 47e-6
+    values = low_band_values(scored, SCREENING_SAMPLES)
     inside = [v for v in values if 47e-6 < v < 103e-6]
     assert len(inside) == 1 and inside[0] == pytest.approx(np.sqrt(4.6912e-05 * 1.0324e-04), rel=1e-4)
     assert len(values) == len(set(values)) and not {v for v, _, _ in BUNDLED_B_SCAN} & set(values)

@@ -17,7 +17,8 @@ around its best point, never a gradient method:
              it, on a side the parabola can guess wrong)
     zoom     four, then two values between each of the two lowest local minima and their neighbours
     vertex   one value at the vertex of a parabola through the profile near its best point (the
-             minimum with the chaotic scatter of single runs smoothed out)
+             minimum with the chaotic scatter of single runs smoothed out), each run weighted by its χ²'s
+             standard deviation, refitted through fewer runs about each new vertex (`profile_vertex`)
 
 A rough candidate (friction: its cost is a comb of narrow minima, the teeth far narrower than any
 affordable grid step) is not zoomed: after the scan, two rounds of evenly spread values in a window
@@ -509,9 +510,8 @@ def parabola_vertex(units: np.ndarray, chi: np.ndarray, centre: float, count: in
 
 
 def chi_square_spread(chi: np.ndarray, effective_samples: float) -> np.ndarray:
-    """σ(χ²) = √(2 n_eff + 4 λ), λ = max(χ² − n_eff, 0): the standard deviation of a non-central χ² of n_eff degrees of
-    freedom and non-centrality λ (Johnson, Kotz & Balakrishnan 1995, ch. 29), χ² of a run that misses the record by λ
-    beyond the noise."""
+    """σ(χ²) = √(2 n_eff + 4 λ), λ = max(χ² − n_eff, 0): a non-central χ²'s (n_eff degrees of freedom, non-centrality
+    λ: a run missing the record by λ beyond the noise; Johnson, Kotz & Balakrishnan 1995, ch. 29; docs/diagnose.md D9)."""
     return np.sqrt(2.0 * effective_samples + 4.0 * np.maximum(chi - effective_samples, 0.0))
 
 

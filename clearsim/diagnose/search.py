@@ -464,11 +464,9 @@ def _smoothed_minimum(scored: Scored, centre: float, half: float, low_band: bool
 
 def profile_vertex(scored: Scored, effective_samples: float, low_band: bool = False) -> float | None:
     """Vertex of the profile's local parabola (χ² of the comparison band, or of the screening band, with
-    `effective_samples` its n_eff), in the candidate's unit range, refitted about each new vertex through fewer of the
-    runs nearest it (PROFILE_POINTS down to VERTEX_POINTS) until it moves by less than VERTEX_TOLERANCE
-    (VERTEX_ITERATIONS at most): the minimum of the profile with the chaotic scatter of single runs smoothed out, set
-    by the runs where the profile is locally quadratic. None when the first parabola is not convex or its vertex
-    leaves its runs' span; a later one that is not: the last vertex that was."""
+    `effective_samples` its n_eff; `settled_vertex`): the minimum of the profile with the chaotic scatter of single runs
+    smoothed out, set by the runs where the profile is locally quadratic. None when the first parabola is not convex
+    or its vertex leaves its runs' span."""
     points = [p for p in scored.points if p.fit is not None]
     if len(points) < 4:
         return None
@@ -476,37 +474,50 @@ def profile_vertex(scored: Scored, effective_samples: float, low_band: bool = Fa
     chi = np.array([p.chi_square_in(low_band) for p in points])
     if not np.all(np.isfinite(chi)):
         return None
-    vertex = None
-    centre = float(units[np.argmin(chi)])
-    for count in vertex_point_counts():
-        moved = parabola_vertex(units, chi, centre, count, effective_samples)
-        if moved is None:
-            break
-        settled = vertex is not None and count == VERTEX_POINTS and abs(moved - vertex) < VERTEX_TOLERANCE
-        vertex = centre = moved
-        if settled:
-            break
+    vertex = settled_vertex(units, chi, effective_samples)
     return float(scored.candidate.from_unit(vertex)) if vertex is not None else None
 
 
+def settled_vertex(units: np.ndarray, chi: np.ndarray, effective_samples: float) -> float | None:
+    """The weighted parabola's vertex (parabola_vertex) through the PROFILE_POINTS runs nearest the lowest, refitted
+    about each new vertex through one run fewer each time down to VERTEX_POINTS until it moves by less than
+    VERTEX_TOLERANCE (VERTEX_ITERATIONS fits at most). When it does not settle, the runs nearest it alternate (their
+    scatter outweighs the curvature there): the vertex of the parabola through the runs of the last two fits. A refit
+    that is not convex, or whose vertex leaves its runs' span, keeps the vertex before it; None when the first is."""
+    vertex, fitted = None, []
+    centre = float(units[np.argmin(chi)])
+    for count in vertex_point_counts():
+        near = np.argsort(np.abs(units - centre))[:count]
+        moved = parabola_vertex(units[near], chi[near], effective_samples)
+        if moved is None:
+            return vertex
+        settled = vertex is not None and count == VERTEX_POINTS and abs(moved - vertex) < VERTEX_TOLERANCE
+        vertex = centre = moved
+        fitted.append(near)
+        if settled:
+            return vertex
+    alternating = np.union1d(*fitted[-2:])
+    both = parabola_vertex(units[alternating], chi[alternating], effective_samples)
+    return both if both is not None else vertex
+
+
 def vertex_point_counts() -> list[int]:
-    """The runs of each refit of profile_vertex: PROFILE_POINTS, one fewer each time down to VERTEX_POINTS, then
+    """The runs of each fit of settled_vertex: PROFILE_POINTS, one fewer each time down to VERTEX_POINTS, then
     VERTEX_POINTS until VERTEX_ITERATIONS."""
     return [max(PROFILE_POINTS - i, VERTEX_POINTS) for i in range(VERTEX_ITERATIONS)]
 
 
-def parabola_vertex(units: np.ndarray, chi: np.ndarray, centre: float, count: int,
-                    effective_samples: float) -> float | None:
-    """Vertex (unit range) of the parabola fitted to the `count` runs nearest `centre`, each weighted by 1/σ(χ²)
-    (chi_square_spread); None when it is not convex or the vertex leaves those runs' span."""
-    near = np.argsort(np.abs(units - centre))[:count]
-    if np.ptp(units[near]) <= 0.0:
+def parabola_vertex(units: np.ndarray, chi: np.ndarray, effective_samples: float) -> float | None:
+    """Vertex (unit range) of the parabola fitted to the runs' χ², each weighted by 1/σ(χ²) (chi_square_spread); None
+    when it is not convex or the vertex leaves the runs' span."""
+    if np.ptp(units) <= 0.0:
         return None
-    a, b, _ = np.polyfit(units[near] - centre, chi[near], 2, w=1.0 / chi_square_spread(chi[near], effective_samples))
+    centre = float(np.mean(units))
+    a, b, _ = np.polyfit(units - centre, chi, 2, w=1.0 / chi_square_spread(chi, effective_samples))
     if a <= 0.0:
         return None
     vertex = centre - b / (2.0 * a)
-    return float(vertex) if units[near].min() <= vertex <= units[near].max() else None
+    return float(vertex) if units.min() <= vertex <= units.max() else None
 
 
 def chi_square_spread(chi: np.ndarray, effective_samples: float) -> np.ndarray:

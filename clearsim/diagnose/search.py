@@ -69,6 +69,7 @@ PROFILE_POINTS = 7  # points of the local parabola through the profile
 VERTEX_POINTS = 5  # the fewest runs of profile_vertex's refits (2 residual degrees of freedom)
 VERTEX_ITERATIONS = 8  # refits of profile_vertex at most
 VERTEX_TOLERANCE = 1e-4  # of the unit range: profile_vertex's vertex has settled when it moves less
+DISTINCT = 1e-3  # of the unit range: the screening band's valley values this close to a run are not run
 VISIBLE = 1.0  # |Δχ²| below 1 at both screening values: the sensors do not see the candidate
 RESONANCE_ROUNDS = 2  # rounds of frequency-matched values for a resonant candidate in screening
 ROUGH_ROUNDS = 2  # rounds of a rough candidate's window about its smoothed minimum
@@ -530,15 +531,25 @@ def low_band_values(scored: Scored, effective_samples: float) -> list[float]:
     """Values about the minimum of the candidate's profile in the screening band, where the valley of the comparison
     band lies when the scan missed it: the profile's vertex (`effective_samples`: n_eff of the screening band) and ± a
     quarter of a scan step, and the midpoints between the lowest run there and its neighbours on either side
-    (`bracket_midpoints`)."""
+    (`bracket_midpoints`); those `apart` from the runs made and from each other."""
     centres = []
     vertex = profile_vertex(scored, effective_samples, low_band=True)
     if vertex is not None:
         centre, quarter = float(scored.candidate.to_unit(vertex)), 0.25 / (SCAN_POINTS + 1)
         centres = [centre - quarter, centre, centre + quarter]
-    known = {p.value for p in scored.points}
-    values = [float(scored.candidate.from_unit(u)) for u in centres + bracket_midpoints(scored, True) if 0.0 <= u <= 1.0]
-    return [v for v in dict.fromkeys(values) if v not in known]
+    known = list(scored.candidate.to_unit([p.value for p in scored.points]))
+    chosen = apart([u for u in centres + bracket_midpoints(scored, True) if 0.0 <= u <= 1.0], known)
+    return [float(scored.candidate.from_unit(u)) for u in chosen]
+
+
+def apart(units: list[float], known: list[float]) -> list[float]:
+    """The values (unit range), in order, each at least DISTINCT from the `known` ones and from those kept before it:
+    a run that close to another tells nothing new, and the zooms would refine the gap between the two."""
+    kept = []
+    for u in units:
+        if all(abs(u - k) >= DISTINCT for k in [*known, *kept]):
+            kept.append(u)
+    return kept
 
 
 def bracket_midpoints(scored: Scored, low_band: bool) -> list[float]:

@@ -10,8 +10,8 @@ from scipy.stats import ncx2
 from clearsim.diagnose.align import Fit
 from clearsim.diagnose.candidates import Candidate
 from clearsim.diagnose.evaluate import Prediction
-from clearsim.diagnose.search import (Point, Scored, bracket_midpoints, chi_square_spread, low_band_values, profile_vertex,
-                                     to_fit)
+from clearsim.diagnose.search import (DISTINCT, Point, Scored, bracket_midpoints, chi_square_spread, low_band_values,
+                                     profile_vertex, to_fit)
 
 # clearance B of the bundled UHV model, 2 µm … 0.5 mm on a log scale, as candidates_for makes it
 CLEARANCE_B = Candidate("clearance", "B", "clearance", "m", 2e-6, 5e-4, True, 5e-6, lambda document, value: None)
@@ -136,3 +136,22 @@ def test_a_vertex_whose_refits_alternate_is_that_of_the_runs_of_both():
     the first fit through the seven runs nearest the lowest does."""
     scored = _scored(FINGERS, [(value, chi, chi) for value, chi in FINGERS_RUNS])
     assert profile_vertex(scored, 270.0) == pytest.approx(3351.2, abs=1.0)
+
+
+# clearance B's screening and scan runs in tests/diagnose/test_diagnose.py's UHV record (0.08 mm hidden, 0.05 % noise):
+# value (m), χ² in the comparison band, χ² in the screening band
+CI_B_SCAN = [(4.4014e-06, 39041.6, 12282.0), (9.6863e-06, 38334.0, 11247.6), (1.0481e-05, 37907.3, 11095.0),
+             (2.1317e-05, 39185.2, 8650.5), (4.6912e-05, 31223.7, 2843.6), (1.0324e-04, 49412.3, 1904.5),
+             (1.1394e-04, 100703.1, 2700.9), (1.2574e-04, 122754.1, 4835.1), (2.2720e-04, 315005.8, 53015.9)]
+
+
+def test_the_valley_values_are_apart_from_each_other_and_from_the_runs():
+    """The screening band's vertex of these runs (69.58 µm) falls on the midpoint between the lowest run there (103 µm)
+    and its neighbour (47 µm: 69.59 µm). Both run, the zooms spent their values refining the gap between the two
+    (69.71-69.94 µm: a comb of χ² 6479-9813) and the valley at 79 µm was never run: clearance A was named. One of
+    them is run."""
+    scored = _scored(CLEARANCE_B, CI_B_SCAN)
+    values = low_band_values(scored, 77.0)
+    units = np.sort(CLEARANCE_B.to_unit(np.array(values + [v for v, _, _ in CI_B_SCAN])))
+    assert np.min(np.diff(units)) >= DISTINCT
+    assert len([v for v in values if 69e-6 < v < 70e-6]) == 1

@@ -69,7 +69,6 @@ PROFILE_POINTS = 7  # points of the local parabola through the profile
 VERTEX_POINTS = 5  # the fewest runs of profile_vertex's refits (2 residual degrees of freedom)
 VERTEX_ITERATIONS = 8  # refits of profile_vertex at most
 VERTEX_TOLERANCE = 1e-4  # of the unit range: profile_vertex's vertex has settled when it moves less
-DISTINCT = 1e-3  # of the unit range: the screening band's valley values this close to a run are not run
 VISIBLE = 1.0  # |Δχ²| below 1 at both screening values: the sensors do not see the candidate
 RESONANCE_ROUNDS = 2  # rounds of frequency-matched values for a resonant candidate in screening
 ROUGH_ROUNDS = 2  # rounds of a rough candidate's window about its smoothed minimum
@@ -412,9 +411,7 @@ def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
     rough = [s for s in chosen if s.candidate.rough]
     for s in rough:
         s.windows = {band: (float(s.candidate.to_unit(lowest(s, band).value)), 1.0 / (SCAN_POINTS + 1)) for band in BANDS}
-    screening_samples = record.low_band.effective_samples if record.low_band is not None else record.effective_samples
-    evaluate_points(evaluator, record, sensors, [(s, v) for s in smooth for v in low_band_values(s, screening_samples)],
-                    document)
+    evaluate_points(evaluator, record, sensors, [(s, v) for s in smooth for v in low_band_values(s)], document)
     for round_ in range(max(len(ZOOM_ROUNDS), ROUGH_ROUNDS)):
         jobs = [(s, v) for s in smooth if round_ < len(ZOOM_ROUNDS) for v in _zoom(s, ZOOM_ROUNDS[round_])]
         jobs += [(s, v) for s in rough if round_ < ROUGH_ROUNDS for v in _window_values(s)]
@@ -463,33 +460,52 @@ def _smoothed_minimum(scored: Scored, centre: float, half: float, low_band: bool
     return float(units[lowest]), half
 
 
-def profile_vertex(scored: Scored, effective_samples: float, low_band: bool = False) -> float | None:
-    """Vertex of the profile's local parabola (χ² of the comparison band, or of the screening band, with
-    `effective_samples` its n_eff; `settled_vertex`): the minimum of the profile with the chaotic scatter of single runs
-    smoothed out, set by the runs where the profile is locally quadratic. None when the first parabola is not convex
-    or its vertex leaves its runs' span."""
-    points = [p for p in scored.points if p.fit is not None]
-    if len(points) < 4:
-        return None
-    units = scored.candidate.to_unit([p.value for p in points])
-    chi = np.array([p.chi_square_in(low_band) for p in points])
-    if not np.all(np.isfinite(chi)):
-        return None
-    vertex = settled_vertex(units, chi, effective_samples)
+def profile_vertex(scored: Scored, effective_samples: float) -> float | None:
+    """Vertex of the profile's local parabola in the comparison band (`effective_samples`: its n_eff; settled_vertex):
+    the minimum of the profile with the chaotic scatter of single runs smoothed out, set by the runs where the profile
+    is locally quadratic. None when the first parabola is not convex or its vertex leaves its runs' span."""
+    profile = finite_profile(scored, low_band=False)
+    vertex = settled_vertex(*profile, effective_samples) if profile is not None else None
     return float(scored.candidate.from_unit(vertex)) if vertex is not None else None
 
 
+def screening_vertex(scored: Scored) -> float | None:
+    """Vertex of the screening band's profile: the parabola through the PROFILE_POINTS runs nearest its lowest,
+    unweighted. There χ² is a few n_eff and its run-to-run scatter the chaotic impacts', not the noise's: weighted by
+    1/σ(χ²) the vertex falls on the luckiest run. None when the parabola is not convex or its vertex leaves its runs'
+    span."""
+    profile = finite_profile(scored, low_band=True)
+    if profile is None:
+        return None
+    units, chi = profile
+    near = np.argsort(np.abs(units - units[np.argmin(chi)]))[:PROFILE_POINTS]
+    vertex = parabola_vertex(units[near], chi[near], np.ones(len(near)))
+    return float(scored.candidate.from_unit(vertex)) if vertex is not None else None
+
+
+def finite_profile(scored: Scored, low_band: bool) -> tuple[np.ndarray, np.ndarray] | None:
+    """The finished runs' values (unit range) and χ² (in the comparison or the screening band); None when fewer than 4
+    or any χ² is not finite."""
+    points = [p for p in scored.points if p.fit is not None]
+    chi = np.array([p.chi_square_in(low_band) for p in points])
+    if len(points) < 4 or not np.all(np.isfinite(chi)):
+        return None
+    return scored.candidate.to_unit([p.value for p in points]), chi
+
+
 def settled_vertex(units: np.ndarray, chi: np.ndarray, effective_samples: float) -> float | None:
-    """The weighted parabola's vertex (parabola_vertex) through the PROFILE_POINTS runs nearest the lowest, refitted
-    about each new vertex through one run fewer each time down to VERTEX_POINTS until it moves by less than
-    VERTEX_TOLERANCE (VERTEX_ITERATIONS fits at most). When it does not settle, the runs nearest it alternate (their
-    scatter outweighs the curvature there): the vertex of the parabola through the runs of the last two fits. A refit
-    that is not convex, or whose vertex leaves its runs' span, keeps the vertex before it; None when the first is."""
+    """The vertex (unit range) of the parabola through the PROFILE_POINTS runs nearest the lowest, each weighted by
+    1/σ(χ²) (chi_square_spread), refitted about each new vertex through one run fewer each time down to VERTEX_POINTS
+    until it moves by less than VERTEX_TOLERANCE (VERTEX_ITERATIONS fits at most). When it does not settle, the runs
+    nearest it alternate (their scatter outweighs the curvature there): the vertex of the parabola through the runs of
+    the last two fits. A refit that is not convex, or whose vertex leaves its runs' span, keeps the vertex before it;
+    None when the first is."""
+    weights = 1.0 / chi_square_spread(chi, effective_samples)
     vertex, fitted = None, []
     centre = float(units[np.argmin(chi)])
     for count in vertex_point_counts():
         near = np.argsort(np.abs(units - centre))[:count]
-        moved = parabola_vertex(units[near], chi[near], effective_samples)
+        moved = parabola_vertex(units[near], chi[near], weights[near])
         if moved is None:
             return vertex
         settled = vertex is not None and count == VERTEX_POINTS and abs(moved - vertex) < VERTEX_TOLERANCE
@@ -498,7 +514,7 @@ def settled_vertex(units: np.ndarray, chi: np.ndarray, effective_samples: float)
         if settled:
             return vertex
     alternating = np.union1d(*fitted[-2:])
-    both = parabola_vertex(units[alternating], chi[alternating], effective_samples)
+    both = parabola_vertex(units[alternating], chi[alternating], weights[alternating])
     return both if both is not None else vertex
 
 
@@ -508,13 +524,13 @@ def vertex_point_counts() -> list[int]:
     return [max(PROFILE_POINTS - i, VERTEX_POINTS) for i in range(VERTEX_ITERATIONS)]
 
 
-def parabola_vertex(units: np.ndarray, chi: np.ndarray, effective_samples: float) -> float | None:
-    """Vertex (unit range) of the parabola fitted to the runs' χ², each weighted by 1/σ(χ²) (chi_square_spread); None
-    when it is not convex or the vertex leaves the runs' span."""
+def parabola_vertex(units: np.ndarray, chi: np.ndarray, weights: np.ndarray) -> float | None:
+    """Vertex (unit range) of the parabola fitted to the runs' χ² by least squares, each residual times its weight;
+    None when it is not convex or the vertex leaves the runs' span."""
     if np.ptp(units) <= 0.0:
         return None
     centre = float(np.mean(units))
-    a, b, _ = np.polyfit(units - centre, chi, 2, w=1.0 / chi_square_spread(chi, effective_samples))
+    a, b, _ = np.polyfit(units - centre, chi, 2, w=weights)
     if a <= 0.0:
         return None
     vertex = centre - b / (2.0 * a)
@@ -527,29 +543,18 @@ def chi_square_spread(chi: np.ndarray, effective_samples: float) -> np.ndarray:
     return np.sqrt(2.0 * effective_samples + 4.0 * np.maximum(chi - effective_samples, 0.0))
 
 
-def low_band_values(scored: Scored, effective_samples: float) -> list[float]:
+def low_band_values(scored: Scored) -> list[float]:
     """Values about the minimum of the candidate's profile in the screening band, where the valley of the comparison
-    band lies when the scan missed it: the profile's vertex (`effective_samples`: n_eff of the screening band) and ± a
-    quarter of a scan step, and the midpoints between the lowest run there and its neighbours on either side
-    (`bracket_midpoints`); those `apart` from the runs made and from each other."""
+    band lies when the scan missed it: the profile's vertex there (screening_vertex) and ± a quarter of a scan step,
+    and the midpoints between the lowest run there and its neighbours on either side (`bracket_midpoints`)."""
     centres = []
-    vertex = profile_vertex(scored, effective_samples, low_band=True)
+    vertex = screening_vertex(scored)
     if vertex is not None:
         centre, quarter = float(scored.candidate.to_unit(vertex)), 0.25 / (SCAN_POINTS + 1)
         centres = [centre - quarter, centre, centre + quarter]
-    known = list(scored.candidate.to_unit([p.value for p in scored.points]))
-    chosen = apart([u for u in centres + bracket_midpoints(scored, True) if 0.0 <= u <= 1.0], known)
-    return [float(scored.candidate.from_unit(u)) for u in chosen]
-
-
-def apart(units: list[float], known: list[float]) -> list[float]:
-    """The values (unit range), in order, each at least DISTINCT from the `known` ones and from those kept before it:
-    a run that close to another tells nothing new, and the zooms would refine the gap between the two."""
-    kept = []
-    for u in units:
-        if all(abs(u - k) >= DISTINCT for k in [*known, *kept]):
-            kept.append(u)
-    return kept
+    known = {p.value for p in scored.points}
+    values = [float(scored.candidate.from_unit(u)) for u in centres + bracket_midpoints(scored, True) if 0.0 <= u <= 1.0]
+    return [v for v in dict.fromkeys(values) if v not in known]
 
 
 def bracket_midpoints(scored: Scored, low_band: bool) -> list[float]:

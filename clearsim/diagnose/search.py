@@ -17,7 +17,8 @@ around its best point, never a gradient method:
              it, on a side the parabola can guess wrong)
     zoom     four, then two values between each of the two lowest local minima and their neighbours
     vertex   one value at the vertex of a parabola through the profile near its best point (the
-             minimum with the chaotic scatter of single runs smoothed out)
+             minimum with the chaotic scatter of single runs smoothed out), each run weighted by its χ²'s
+             standard deviation, refitted through fewer runs about each new vertex (`profile_vertex`)
 
 A rough candidate (friction: its cost is a comb of narrow minima, the teeth far narrower than any
 affordable grid step) is not zoomed: after the scan, two rounds of evenly spread values in a window
@@ -65,6 +66,9 @@ ZOOM_MINIMA = 2  # zoom around the two lowest local minima of the profile
 SIGNIFICANCE = 10.0  # ΔBIC below −10: "very strong" evidence (Kass & Raftery 1995)
 TIE = 6.0  # BIC within 6 of the best: the data do not tell the two apart
 PROFILE_POINTS = 7  # points of the local parabola through the profile
+VERTEX_POINTS = 5  # the fewest runs of profile_vertex's refits (2 residual degrees of freedom)
+VERTEX_ITERATIONS = 8  # refits of profile_vertex at most
+VERTEX_TOLERANCE = 1e-4  # of the unit range: profile_vertex's vertex has settled when it moves less
 VISIBLE = 1.0  # |Δχ²| below 1 at both screening values: the sensors do not see the candidate
 RESONANCE_ROUNDS = 2  # rounds of frequency-matched values for a resonant candidate in screening
 ROUGH_ROUNDS = 2  # rounds of a rough candidate's window about its smoothed minimum
@@ -415,7 +419,7 @@ def refine(evaluator, record, sensors, chosen: list[Scored], document) -> None:
         for s in rough if round_ < ROUGH_ROUNDS else []:
             s.profiles = {band: _smoothed_minimum(s, *s.windows[band], band) for band in BANDS}
             s.windows = {band: (s.profiles[band][0], s.windows[band][1] / 2.0) for band in BANDS}
-    jobs = [(s, v) for s in smooth if (v := profile_vertex(s)) is not None]
+    jobs = [(s, v) for s in smooth if (v := profile_vertex(s, record.effective_samples)) is not None]
     jobs += [(s, float(s.candidate.from_unit(s.smoothed[0]))) for s in rough]
     evaluate_points(evaluator, record, sensors, jobs, document)
     for s in chosen:
@@ -456,37 +460,95 @@ def _smoothed_minimum(scored: Scored, centre: float, half: float, low_band: bool
     return float(units[lowest]), half
 
 
-def profile_vertex(scored: Scored, low_band: bool = False) -> float | None:
-    """Vertex of a parabola fitted (least squares) to χ² (of the comparison band, or of the screening band)
-    over the points near the best one, in the candidate's unit range: the minimum of the profile with the
-    chaotic scatter of single runs smoothed out. None when the local profile is not convex or the vertex
-    leaves the points' span."""
+def profile_vertex(scored: Scored, effective_samples: float) -> float | None:
+    """Vertex of the profile's local parabola in the comparison band (`effective_samples`: its n_eff; settled_vertex):
+    the minimum of the profile with the chaotic scatter of single runs smoothed out, set by the runs where the profile
+    is locally quadratic. None when the first parabola is not convex or its vertex leaves its runs' span."""
+    profile = finite_profile(scored, low_band=False)
+    vertex = settled_vertex(*profile, effective_samples) if profile is not None else None
+    return float(scored.candidate.from_unit(vertex)) if vertex is not None else None
+
+
+def screening_vertex(scored: Scored) -> float | None:
+    """Vertex of the screening band's profile: the parabola through the PROFILE_POINTS runs nearest its lowest,
+    unweighted. There χ² is a few n_eff and its run-to-run scatter the chaotic impacts', not the noise's: weighted by
+    1/σ(χ²) the vertex falls on the luckiest run. None when the parabola is not convex or its vertex leaves its runs'
+    span."""
+    profile = finite_profile(scored, low_band=True)
+    if profile is None:
+        return None
+    units, chi = profile
+    near = np.argsort(np.abs(units - units[np.argmin(chi)]))[:PROFILE_POINTS]
+    vertex = parabola_vertex(units[near], chi[near], np.ones(len(near)))
+    return float(scored.candidate.from_unit(vertex)) if vertex is not None else None
+
+
+def finite_profile(scored: Scored, low_band: bool) -> tuple[np.ndarray, np.ndarray] | None:
+    """The finished runs' values (unit range) and χ² (in the comparison or the screening band); None when fewer than 4
+    or any χ² is not finite."""
     points = [p for p in scored.points if p.fit is not None]
-    if len(points) < 4:
-        return None
-    units = scored.candidate.to_unit([p.value for p in points])
     chi = np.array([p.chi_square_in(low_band) for p in points])
-    if not np.all(np.isfinite(chi)):
+    if len(points) < 4 or not np.all(np.isfinite(chi)):
         return None
+    return scored.candidate.to_unit([p.value for p in points]), chi
+
+
+def settled_vertex(units: np.ndarray, chi: np.ndarray, effective_samples: float) -> float | None:
+    """The vertex (unit range) of the parabola through the PROFILE_POINTS runs nearest the lowest, each weighted by
+    1/σ(χ²) (chi_square_spread), refitted about each new vertex through one run fewer each time down to VERTEX_POINTS
+    until it moves by less than VERTEX_TOLERANCE (VERTEX_ITERATIONS fits at most). When it does not settle, the runs
+    nearest it alternate (their scatter outweighs the curvature there): the vertex of the parabola through the runs of
+    the last two fits. A refit that is not convex, or whose vertex leaves its runs' span, keeps the vertex before it;
+    None when the first is."""
+    weights = 1.0 / chi_square_spread(chi, effective_samples)
+    vertex, fitted = None, []
     centre = float(units[np.argmin(chi)])
-    near = np.argsort(np.abs(units - centre))[:PROFILE_POINTS]
-    if np.ptp(units[near]) <= 0.0:
+    for count in vertex_point_counts():
+        near = np.argsort(np.abs(units - centre))[:count]
+        moved = parabola_vertex(units[near], chi[near], weights[near])
+        if moved is None:
+            return vertex
+        settled = vertex is not None and count == VERTEX_POINTS and abs(moved - vertex) < VERTEX_TOLERANCE
+        vertex = centre = moved
+        fitted.append(near)
+        if settled:
+            return vertex
+    alternating = np.union1d(*fitted[-2:])
+    both = parabola_vertex(units[alternating], chi[alternating], weights[alternating])
+    return both if both is not None else vertex
+
+
+def vertex_point_counts() -> list[int]:
+    """The runs of each fit of settled_vertex: PROFILE_POINTS, one fewer each time down to VERTEX_POINTS, then
+    VERTEX_POINTS until VERTEX_ITERATIONS."""
+    return [max(PROFILE_POINTS - i, VERTEX_POINTS) for i in range(VERTEX_ITERATIONS)]
+
+
+def parabola_vertex(units: np.ndarray, chi: np.ndarray, weights: np.ndarray) -> float | None:
+    """Vertex (unit range) of the parabola fitted to the runs' χ² by least squares, each residual times its weight;
+    None when it is not convex or the vertex leaves the runs' span."""
+    if np.ptp(units) <= 0.0:
         return None
-    a, b, _ = np.polyfit(units[near] - centre, chi[near], 2)
+    centre = float(np.mean(units))
+    a, b, _ = np.polyfit(units - centre, chi, 2, w=weights)
     if a <= 0.0:
         return None
     vertex = centre - b / (2.0 * a)
-    if not units[near].min() <= vertex <= units[near].max():
-        return None
-    return float(scored.candidate.from_unit(vertex))
+    return float(vertex) if units.min() <= vertex <= units.max() else None
+
+
+def chi_square_spread(chi: np.ndarray, effective_samples: float) -> np.ndarray:
+    """σ(χ²) = √(2 n_eff + 4 λ), λ = max(χ² − n_eff, 0): a non-central χ²'s (n_eff degrees of freedom, non-centrality
+    λ: a run missing the record by λ beyond the noise; Johnson, Kotz & Balakrishnan 1995, ch. 29; docs/diagnose.md D9)."""
+    return np.sqrt(2.0 * effective_samples + 4.0 * np.maximum(chi - effective_samples, 0.0))
 
 
 def low_band_values(scored: Scored) -> list[float]:
     """Values about the minimum of the candidate's profile in the screening band, where the valley of the comparison
-    band lies when the scan missed it: the profile's vertex and ± a quarter of a scan step, and the midpoints between
-    the lowest run there and its neighbours on either side (`bracket_midpoints`)."""
+    band lies when the scan missed it: the profile's vertex there (screening_vertex) and ± a quarter of a scan step,
+    and the midpoints between the lowest run there and its neighbours on either side (`bracket_midpoints`)."""
     centres = []
-    vertex = profile_vertex(scored, low_band=True)
+    vertex = screening_vertex(scored)
     if vertex is not None:
         centre, quarter = float(scored.candidate.to_unit(vertex)), 0.25 / (SCAN_POINTS + 1)
         centres = [centre - quarter, centre, centre + quarter]

@@ -90,15 +90,14 @@ def _worn_pocket(joint, parameters, path: tuple) -> list[Problem]:
     profile = joint.wear.profile if joint.wear is not None else None
     if profile is None:
         return []
-    from clearsim.physics.wear import tightest_radius
+    from clearsim.physics.wear import pocket_radius, pocket_words
 
-    tightest = tightest_radius(profile.coefficients(), parameters.bearing_radius)
-    if tightest >= parameters.journal_radius:
+    tightest = pocket_radius(profile.coefficients(), parameters.bearing_radius, parameters.journal_radius)
+    if tightest is None:
         return []
     return [Problem(path + ("wear", "profile"), f"the worn bore of joint '{joint.name}' has a pocket tighter than its "
-                    f"journal (smallest radius of curvature {_length(tightest)} against the journal's "
-                    f"{_length(parameters.journal_radius)}): the journal touches it at two points and the contact "
-                    "flips between them, which makes the run take tiny steps",
+                    f"journal ({pocket_words(tightest, parameters.journal_radius)}): the journal touches it at two "
+                    "points and the contact flips between them, which makes the run take tiny steps",
                     "check the profile's units and harmonics: a journal wears a pocket at least as wide as itself "
                     "(fewer or smaller high harmonics widen it)")]
 

@@ -339,6 +339,22 @@ def tightest_radius(coefficients, bearing_radius: float) -> float:
     return _smallest_curvature_radius(coefficients, harmonics, bearing_radius, 64 * max(harmonics, 1))
 
 
+def pocket_radius(coefficients, bearing_radius: float, journal_radius: float) -> float | None:
+    """The bore's tightest radius of curvature (m) where it is tighter than the journal, a pocket the journal touches
+    at its two rims (the one-point contact takes the nearer, and its normal flips as the journal crosses); None where
+    the bore is nowhere tighter than the journal (or circular)."""
+    if (len(coefficients) - 1) // 2 <= 0:
+        return None
+    tightest = tightest_radius(coefficients, bearing_radius)
+    return tightest if tightest < journal_radius else None
+
+
+def pocket_words(tightest: float, journal_radius: float) -> str:
+    """The two radii of a pocket, to the 0.1 µm that tells them apart (both are R_B to within the clearance)."""
+    return (f"smallest radius of curvature {tightest * 1e3:.4f} mm against the journal's "
+            f"{journal_radius * 1e3:.4f} mm")
+
+
 REACH_MARGIN = 1e-9  # relative: the refined tightest radius is a local minimum to round-off (its argument to
 # 1e-13 rad changes it by ~1e-26 of itself); the margin keeps the reach below it whatever the last digits
 

@@ -93,6 +93,7 @@ NORMAL, TANGENTIAL = 0, 1  # the two event functions of a clearance joint
 UNSOLVED = np.nan  # event_value's friction of a sticking joint: not known, solve for it
 SLIDE_HYSTERESIS = 1e-9  # m/s: ε_v of the sliding-stops event, far below any resolved sliding speed
 DECIDE_SPEED = 1e-6  # m/s: below it a contact tests whether it sticks (settle_friction)
+JUMP_WIDENING = 1e-6  # of the event step: its first lengthening past a jump of the sliding speed (refine_event)
 DEEPEST_PENETRATION = 0.05  # of the journal radius: beyond it no contact law means anything
 UNRESOLVED_RATIO = 3.0  # position tolerance over an impact's Hertz penetration above which a run warns (model.md §4)
 
@@ -633,20 +634,41 @@ def jacobian_due(ints, modes, jacobian_modes):
 
 
 @njit(cache=True, inline="always")
-def refine_event(system, dynamics, projection, implicit_step, k, kind, t, y, f, h_event, modes, speeds, stages, y_event,
-                 real, ints, jacobian, jacobian_modes):
+def jumped_across(system, dynamics, k, kind, t, y, stages, h, theta, modes, speeds, scratch):
+    """Whether a sliding joint's TANGENTIAL event at θ of the step (s v_t + ε_v crossing 0) is a jump across 0 rather
+    than a zero: just past the located crossing the joint slides the other way faster than DECIDE_SPEED (a smooth
+    crossing, located to 1e-13 of the step, is within ~1e-12 m/s of 0 there). v_t jumps where the nearest point of a
+    worn bore leaves one rim of a pocket tighter than the journal for the other, turning the contact's normal."""
+    if kind != TANGENTIAL or modes[k] == FREE or modes[k] == STICK or not exact_stick(system, k):
+        return False
+    return _value_at(system, dynamics, k, kind, t, y, stages, h, theta, modes, speeds, scratch)[0] < -DECIDE_SPEED
+
+
+@njit(cache=True, inline="always")
+def refine_event(system, dynamics, projection, implicit_step, k, kind, t, y, f, h_event, h_limit, modes, speeds, stages,
+                 y_event, real, ints, jacobian, jacobian_modes):
     """Integrate from t exactly to joint k's event; returns the step length.
 
     NORMAL events: Newton on the step length until |δ| < 1e-3 ε. TANGENTIAL events: the dense-output
-    root, integrated once (settle_friction decides from the state reached, whichever side it is on).
+    root, integrated once (settle_friction decides from the state reached, whichever side it is on); a jump of the
+    sliding speed across 0 (jumped_across; h_limit > h_event, the step it lies in) is integrated past: the step
+    integrated again puts the jump a little off the dense output's, so it is lengthened (by JUMP_WIDENING of itself,
+    then tenfold each time, at most to h_limit) until the state reached is past it and the joint slides on the other
+    way.
     """
     tolerance = 1e-3 * hysteresis(system, k)
+    widening = JUMP_WIDENING * h_event
     for _ in range(6):
         ints[I_RHS] += method_step(system, dynamics, implicit_step, t, y, f, h_event, modes, speeds, stages, y_event,
                                    real, ints, jacobian, jacobian_modes, False)[1]
         projection(system, t + h_event, y_event, modes)
         if kind == TANGENTIAL:
-            break
+            if h_event >= h_limit or event_value(system, dynamics, k, kind, t + h_event, y_event, modes, speeds,
+                                                 UNSOLVED)[0] < 0.0:
+                break
+            h_event = min(h_event + widening, h_limit)
+            widening *= 10.0
+            continue
         g, rate = event_value(system, dynamics, k, kind, t + h_event, y_event, modes, speeds, UNSOLVED)
         if abs(g) <= tolerance or rate == 0.0:
             break
@@ -732,8 +754,11 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
         event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, points,
                                                               frictions, modes, speeds, scratch)
         if event_joint >= 0:
+            jump = jumped_across(system, dynamics, event_joint, event_kind, t, y, stages, h, event_theta, modes, speeds,
+                                 scratch)
             h = refine_event(system, dynamics, projection, implicit_step, event_joint, event_kind, t, y, f,
-                             event_theta * h, modes, speeds, stages, y_new, real, ints, jacobian, jacobian_modes)
+                             event_theta * h, h if jump else event_theta * h, modes, speeds, stages, y_new, real, ints,
+                             jacobian, jacobian_modes)
             ints[I_RHS] += extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints)
             fill_subdivisions(y, stages, h, points)  # the step integrated again, to the event
         emit_samples(system, dynamics, films, projection, implicit_step, t, y, f, stages, h, t + h, modes, speeds,

@@ -14,7 +14,9 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from clearsim.assembly.arrays import CL_BEARING_RADIUS, CL_MU_D, CL_MU_S, CL_STIFFNESS, for_kernels
+from clearsim.assembly.arrays import (
+    CL_BEARING_RADIUS, CL_JOURNAL_RADIUS, CL_MU_D, CL_MU_S, CL_STIFFNESS, for_kernels,
+)
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints
 from clearsim.assembly.drivelines import puffer_overrun
 from clearsim.assembly.dynamics import WORK_COUNT, has_oil_films
@@ -22,6 +24,7 @@ from clearsim.assembly.forces import FREE
 from clearsim.assembly.system import System
 from clearsim.errors import SolverError
 from clearsim.model.schema import SolverSettings
+from clearsim.physics.wear import pocket_radius, pocket_words
 from clearsim.solver import integrator as ig
 from clearsim.solver import precompile
 from clearsim.solver.outputs import hertz_durations, output_acceleration_point, output_rate
@@ -176,10 +179,33 @@ def mechanism_extent(system: System) -> float:
     return float(np.max(np.ptp(positions, axis=0))) if len(positions) > 1 else 0.0
 
 
+def worn_pockets(system: System) -> list[str]:
+    """In words (a list of one, or none): the clearance joints whose worn bore has a pocket tighter than the journal.
+    A journal pressed into it touches its two rims, the one-point contact takes the nearer and its normal flips
+    between them as the journal crosses, and the steps follow every flip (docs/model-contact.md, "Contact on a worn
+    bore")."""
+    arrays = system.arrays
+    pockets = []
+    for k, name in enumerate(system.clearance_joints):
+        harmonics = int(arrays.wear_harmonics[k])
+        params = arrays.clearance_params[k]
+        tightest = pocket_radius(arrays.wear_profile[k, :2 * harmonics + 1], params[CL_BEARING_RADIUS],
+                                 params[CL_JOURNAL_RADIUS])
+        if tightest is not None:
+            pockets.append(f"joint {name} ({pocket_words(tightest, params[CL_JOURNAL_RADIUS])})")
+    if not pockets:
+        return []
+    return [f"a worn bore with a pocket tighter than its journal at {', '.join(pockets)}: the journal touches the "
+            "pocket's two rims and the contact's normal flips between them at every crossing, which the steps follow; "
+            "give `wear.profile` no pocket narrower than the journal (R_B + h + h'' >= R_J everywhere: fewer or "
+            "smaller high harmonics)"]
+
+
 def likely_causes(system: System, pace: Pace) -> list[str]:
-    """What in the model makes the steps this short, as far as its parameters tell."""
+    """What in the model makes the steps this short, as far as its parameters tell: a worn pocket first (it makes
+    any contact in it crawl), then the joint's or the model's parameters."""
     settings = system.mechanism.solver
-    causes = []
+    causes = worn_pockets(system)
     if pace.joint >= 0:
         params = system.arrays.clearance_params[pace.joint]
         radius, extent = params[CL_BEARING_RADIUS], mechanism_extent(system)
@@ -422,7 +448,10 @@ class Run:
         if overrun is not None:
             return SolverError(overrun[1], time=t, element=overrun[0], hint=overrun[2], kind="force")
         message, hint = messages[status]
-        if status == ig.MIN_STEP and all(mode == FREE for mode in self.modes):
+        pockets = worn_pockets(self.system)
+        if status in (ig.MIN_STEP, ig.CHATTER) and pockets:
+            hint = f"{'; '.join(pockets)}. Otherwise: {hint}"
+        elif status == ig.MIN_STEP and all(mode == FREE for mode in self.modes):
             # no contact is closed: the stiff or jumping force is elsewhere (found by the input fuzz: a mass of
             # 1e300 kg stopped here with the contact hint)
             hint = ("no clearance joint is in contact here, so it is not a contact: check masses, inertias, spring "

@@ -137,3 +137,41 @@ def test_a_slow_run_warns_once_with_its_pace_and_finishes(monkeypatch):
     assert history.complete and history.chunk.times[-1] == pytest.approx(0.024)
     (text,) = warned
     assert text.startswith("at t = ") and "at this pace the remaining" in text and "likely causes" not in text
+
+
+
+
+UHV = CONFIGS / "uhv_breaker.yaml"
+# an oval 20 µm deep at A and J (radius of curvature 49.9601 mm at its bottom, against the journal's 49.9900 mm): the
+# journal pressed into it touches both rims (at A at 0.785 ms: 48° either side of the bottom, 8.8 and 8.3 µm deep),
+# and the contact's normal flips between them at every crossing; from 2.9 ms on the steps collapse to 2.5 ns
+OVAL_POCKET = [f"joints.{joint}.wear.profile.cos=[0.02mm, 0, 0.02mm]" for joint in "AJ"]
+POCKET = "a worn bore with a pocket tighter than its journal at joint A (smallest radius of curvature 49.9601 mm"
+
+
+def test_a_run_collapsed_in_a_worn_pocket_names_the_pocket_first(tmp_path):
+    """The collapse's likely causes give the pocket, its radius against the journal's and the fix, before the
+    friction; the partial result is written and flagged."""
+    report = simulate_config(UHV, OVAL_POCKET, tmp_path / "r.h5")  # the 85 ms stroke: hopeless at 2.9 ms
+    assert not report.complete and isinstance(report.error, SolverError), report.status
+    text = str(report.error)
+    assert "collapsed" in text and report.error.time < 4e-3
+    assert text.index(POCKET) < text.index("friction")
+    assert "against the journal's 49.9900 mm" in text and "R_B + h + h'' >= R_J" in text
+    with h5py.File(report.output, "r") as result:
+        assert not result.attrs["complete"] and POCKET in result.attrs["status"]
+
+
+def test_a_stop_at_min_step_in_a_worn_pocket_names_the_pocket_first():
+    run = sim.Run(prepare(load_mechanism(UHV, OVAL_POCKET)))
+    run.modes[:] = 1  # in contact
+    text = str(run._failure(ig.MIN_STEP))
+    assert "solver.min_step" in text and text.index(POCKET) < text.index("Otherwise: a contact stiffer")
+
+
+def test_collapsed_steps_in_a_worn_pocket_give_the_pocket_as_the_first_likely_cause():
+    system = prepare(load_mechanism(UHV, OVAL_POCKET))
+    pace = sim.Pace(time=4e-3, steps=20_000, advanced=1e-4, remaining_time=81e-3, joint=0, contact_time=1.6e-4)
+    causes = sim.likely_causes(system, pace)
+    assert causes[0].startswith(POCKET) and any("friction" in cause for cause in causes[1:])
+    assert sim.likely_causes(prepare(load_mechanism(UHV)), pace)[0].startswith("friction")  # no pocket, no such cause

@@ -85,8 +85,9 @@ def test_stiffness_modulus_and_clearance_far_outside_the_physical_range(old, new
 @pytest.mark.parametrize("harmonics, expected", [
     # at the deepest point ρ = R_B + 2a = 10.04 mm, radius of curvature ρ²/(ρ + m² a) for a cos mθ
     ("0.02 mm, 0, 0.02 mm", ""),  # an oval pocket (m = 2): 9.96 mm
-    ("0.02 mm, 0, 0, 0, 0, 0, 0, 0, 0.02 mm", "the worn bore of joint 'slider_pin' has a pocket tighter than its journal "
-                                               "(smallest radius of curvature 8.9 mm"),  # m = 8
+    ("0.02 mm, 0, 0, 0, 0, 0, 0, 0, 0.02 mm",  # m = 8; the radii to 0.1 µm, which tells them apart near R_B too
+     "the worn bore of joint 'slider_pin' has a pocket tighter than its journal "
+     "(smallest radius of curvature 8.9047 mm against the journal's 9.5000 mm)"),
 ], ids=["wider than the journal", "tighter than the journal"])
 def test_a_worn_pocket_tighter_than_the_journal(harmonics, expected):
     """The slider pin's journal is 9.5 mm in a 10 mm bore: a pocket whose radius of curvature falls below 9.5 mm

@@ -103,10 +103,11 @@ WEAR_EXAMPLE = re.compile(r"^    (wear: \{.*?\}\})\s*$", re.MULTILINE | re.DOTAL
 
 def test_the_wear_block_of_the_contact_page_is_accepted_on_a_clearance_joint():
     """The `wear:` example of model-contact.md, as printed, on the bundled breaker's joint A: a valid profile (depth ≥ 0
-    everywhere) and Archard block, not an input error."""
+    everywhere) and Archard block, not an input error, and no pocket tighter than the journal (no warning)."""
     import yaml
 
     from clearsim.model.loader import load_mechanism_text
+    from clearsim.model.plausibility import plausibility_warnings
 
     example = yaml.safe_load(WEAR_EXAMPLE.search((DOCS / "model-contact.md").read_text(encoding="utf-8")).group(1))
     document = yaml.safe_load((ROOT / "clearsim" / "configs" / "uhv_breaker.yaml").read_text(encoding="utf-8"))
@@ -114,3 +115,4 @@ def test_the_wear_block_of_the_contact_page_is_accepted_on_a_clearance_joint():
     joint["wear"] = example["wear"]
     mechanism = load_mechanism_text(yaml.safe_dump(document)).mechanism
     assert next(j for j in mechanism.joints if j.name == "A").wear.profile is not None
+    assert not [w for w in plausibility_warnings(mechanism) if "wear" in w.path]

@@ -184,8 +184,13 @@ def _workspace(arrays: SystemArrays) -> tuple:
 def for_kernels(arrays: SystemArrays) -> KernelArrays:
     """The arrays as every compiled kernel takes them (one compiled specialisation for all callers), with the
     scratch of their solves."""
-    fields = tuple(arrays) + _workspace(arrays)
-    bore_point = bore_point_kernel(arrays.wear_harmonics)
+    return packed(tuple(arrays) + _workspace(arrays), arrays.wear_harmonics)
+
+
+def packed(fields: tuple, wear_harmonics: np.ndarray) -> KernelArrays:
+    """KernelArrays of the fields (a SystemArrays' and its workspace's, in KERNEL_FIELDS' order) with the worn bores'
+    nearest-point kernel the joints' wear harmonics call for (wear.bore_point_kernel)."""
+    bore_point = bore_point_kernel(wear_harmonics)
     if not _numba_target_ready:
         return _first_pack(fields, bore_point)
     return _packed(fields, bore_point)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from benchmarks.chain import pendulum_chain
-from clearsim.assembly.arrays import WORKSPACE_FIELDS, KernelArrays, SystemArrays, _workspace
+from clearsim.assembly.arrays import WORKSPACE_FIELDS, SystemArrays, _workspace, packed
 from clearsim.assembly.constraints import constraint_count, dense_jacobian, jacobian_blocks, schur_complement
 from clearsim.assembly.dynamics import FACTOR_SINGULAR, FACTOR_SPD, accelerations, factored_jacobian, factorize, solve_factored
 from clearsim.assembly.forces import CONTACT, STICK
@@ -27,7 +27,7 @@ class Scratch:
     def __init__(self, arrays: SystemArrays):
         fields = tuple(arrays) + _workspace(arrays)
         self.__dict__.update(zip(list(SystemArrays._fields) + WORKSPACE_FIELDS, fields))
-        self.system = KernelArrays(*fields)
+        self.system = packed(fields, arrays.wear_harmonics)
 
 
 @functools.cache

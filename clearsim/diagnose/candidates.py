@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import copy
 import math
-import tempfile
 from dataclasses import dataclass, replace
 from functools import lru_cache, partial
 from pathlib import Path
@@ -514,25 +513,26 @@ def load_scales(document: dict, base_dir: Path, axes: dict[str, tuple[float, flo
 
 @lru_cache(maxsize=8)
 def _load_scales(text: str, base_dir: str, axes: tuple) -> tuple:
-    import h5py
+    from clearsim.errors import SolverError
+    from clearsim.runner import prepare
+    from clearsim.solver.simulate import simulate
 
-    from clearsim.runner import prepare, run_to_file
-
-    loaded = load_mechanism_text(text, "load scale", (), Path(base_dir))
-    system = prepare(loaded)  # its bodies: a flexible link's halves and segments in place of the link
-    with tempfile.TemporaryDirectory() as folder:
-        report = run_to_file(system, loaded, Path(folder) / "model.h5")
-        if not report.complete:
-            return ()
-        with h5py.File(report.output, "r") as result:
-            energy = sum(_kinetic_energy(body, result[f"bodies/{body.name}/qd"][:]) for body in system.mechanism.bodies)
-            travels = {body: float(np.ptp(result[f"bodies/{body}/q"][:, :2] @ np.asarray(axis))) for body, axis in axes}
-    return tuple((body, float(np.max(energy)) / travel) for body, travel in travels.items() if travel > MIN_TRAVEL)
+    system = prepare(load_mechanism_text(text, "load scale", (), Path(base_dir)))  # a flexible link's parts as bodies
+    try:
+        samples = simulate(system).chunk
+    except SolverError:
+        return ()
+    n = system.coordinate_count
+    travels = {body: float(np.ptp(samples.states[:, :n][:, _planar(system, body)] @ np.asarray(axis)))
+               for body, axis in axes}
+    return tuple((body, float(np.max(samples.kinetic)) / travel) for body, travel in travels.items()
+                 if travel > MIN_TRAVEL)
 
 
-def _kinetic_energy(body, velocities: np.ndarray) -> np.ndarray:
-    """½ m (ẋ² + ẏ²) + ½ J θ̇² of a body at each sample (J about its centre of mass)."""
-    return 0.5 * body.mass * (velocities[:, 0] ** 2 + velocities[:, 1] ** 2) + 0.5 * body.inertia * velocities[:, 2] ** 2
+def _planar(system, body: str) -> slice:
+    """The columns of a body's x and y in q."""
+    b = system.body_names.index(body)
+    return slice(3 * b, 3 * b + 2)
 
 
 MIN_TRAVEL = 1e-6  # m: a slider that moves less has no load scale (E_max / s)

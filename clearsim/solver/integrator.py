@@ -84,6 +84,10 @@ STEPS_PER_CALL = 20_000
 STALLED_STEPS = 2000  # consecutive accepted steps shorter than min_step: the events no longer advance the time
 
 SUBDIVISIONS = 4  # points per step at which the event functions are sampled
+# fill_point_kinematics: a row per point (the step's start, its subdivisions, its end y_new, then EXTENSION_END: the
+# continuous extension at θ = 1, a rounding away from y_new, which the peak search reads), a joint's δ, δ̇ and v_t each
+EXTENSION_END = SUBDIVISIONS + 1
+K_PENETRATION, K_RATE, K_SLIDING = range(3)
 PROJECTION_TOLERANCE = 1e-13  # m (rad): max |Φ| kept after each step
 DRIFT_LIMIT = 1e-8  # m: a projection that cannot get below this has lost the assembly
 SAFETY = 0.9
@@ -110,15 +114,15 @@ def friction_reserve(system, dynamics, t, y, modes, speeds, k):
     n = coordinate_count(system)
     friction = -dynamics(system, t, y[:n], y[n:2 * n], element_states(system, y), modes, speeds)[1][
         stick_row_index(system, modes, k)]
-    return reserve_left(system, k, y, modes, speeds, friction)
+    kin = clearance_kinematics(system, k, y[:n], y[n:2 * n])
+    return reserve_left(system, k, kin[4], kin[5], kin[8], modes, speeds, friction)
 
 
 @njit(cache=True, inline="always")
-def reserve_left(system, k, y, modes, speeds, friction):
-    """(μ_s F_n − |F_t|, F_t) of sticking joint k in state y, whose stick constraint needs the friction force F_t."""
-    n = coordinate_count(system)
-    kin = clearance_kinematics(system, k, y[:n], y[n:2 * n])
-    normal = contact_force_magnitudes(system, k, kin[4], kin[5], kin[8], modes[k], speeds[k])[0]
+def reserve_left(system, k, penetration, rate, sliding, modes, speeds, friction):
+    """(μ_s F_n − |F_t|, F_t) of sticking joint k at δ, δ̇ and v_t (clearance_kinematics), whose stick constraint needs
+    the friction force F_t."""
+    normal = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], speeds[k])[0]
     p = system.clearance_params[k]
     return static_coefficient(system.clearance_laws[k, 1], p[CL_MU_S], p[CL_MU_D]) * normal - abs(friction), friction
 
@@ -149,19 +153,27 @@ def event_value(system, dynamics, k, kind, t, y, modes, speeds, friction):
     constrained solve of the whole state); the other event functions read the joint's two bodies alone.
     """
     n = coordinate_count(system)
+    if kind == TANGENTIAL and (modes[k] == FREE or not exact_stick(system, k)):
+        return 1.0, 0.0
+    if kind == TANGENTIAL and modes[k] == STICK and friction != friction:  # UNSOLVED
+        return friction_reserve(system, dynamics, t, y, modes, speeds, k)[0], 0.0
+    kin = clearance_kinematics(system, k, y[:n], y[n:2 * n])
+    return kinematic_event_value(system, k, kind, kin[4], kin[5], kin[8], modes, speeds, friction)
+
+
+@njit(cache=True, inline="always")
+def kinematic_event_value(system, k, kind, penetration, rate, sliding, modes, speeds, friction):
+    """event_value from joint k's δ, δ̇ and v_t (clearance_kinematics), a sticking joint's F_t known."""
     mode = modes[k]
     if kind == NORMAL:
-        kin = clearance_kinematics(system, k, y[:n], y[n:2 * n])
         shift = hysteresis(system, k) if mode != FREE else 0.0
-        return kin[4] + shift, kin[5]
+        return penetration + shift, rate
     if mode == FREE or not exact_stick(system, k):
         return 1.0, 0.0
     if mode == STICK:
-        if friction != friction:  # UNSOLVED
-            return friction_reserve(system, dynamics, t, y, modes, speeds, k)[0], 0.0
-        return reserve_left(system, k, y, modes, speeds, friction)[0], 0.0
+        return reserve_left(system, k, penetration, rate, sliding, modes, speeds, friction)[0], 0.0
     direction = -1.0 if mode == SLIDE_BACK else 1.0
-    return direction * clearance_kinematics(system, k, y[:n], y[n:2 * n])[8] + SLIDE_HYSTERESIS, 0.0
+    return direction * sliding + SLIDE_HYSTERESIS, 0.0
 
 
 @njit(cache=True, inline="always")
@@ -258,21 +270,18 @@ def _root(system, dynamics, k, kind, t, y, stages, h, lo, hi, modes, speeds, scr
 
 
 @njit(cache=True, inline="always")
-def first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, frictions, modes, speeds, scratch):
-    """θ in (0, 1] of joint k's first event of this kind in the step, or 2.0 when there is none (points: the step's
-    continuous extension at its subdivisions, fill_subdivisions; frictions: the sticking joints' F_t there,
-    fill_stick_frictions)."""
+def first_event(system, dynamics, k, kind, t, y, stages, h, kinematics, frictions, modes, speeds, scratch):
+    """θ in (0, 1] of joint k's first event of this kind in the step, or 2.0 when there is none (kinematics: the
+    joints' δ, δ̇ and v_t at the step's start, subdivisions and end, fill_point_kinematics; frictions: the sticking
+    joints' F_t there, fill_stick_frictions)."""
     mode = modes[k]
     if kind == TANGENTIAL and (mode == FREE or not exact_stick(system, k)):
         return 2.0
-    g_prev, r_prev = event_value(system, dynamics, k, kind, t, y, modes, speeds, frictions[0, k])
+    g_prev, r_prev = point_event_value(system, k, kind, kinematics[0, k], modes, speeds, frictions[0, k])
     theta_prev = 0.0
     for i in range(1, SUBDIVISIONS + 1):
         theta = i / SUBDIVISIONS
-        if i == SUBDIVISIONS:
-            g, r = event_value(system, dynamics, k, kind, t + h, y_new, modes, speeds, frictions[i, k])
-        else:
-            g, r = event_value(system, dynamics, k, kind, t + theta * h, points[i], modes, speeds, frictions[i, k])
+        g, r = point_event_value(system, k, kind, kinematics[i, k], modes, speeds, frictions[i, k])
         if _crossed(mode, kind, g_prev, g):
             return _root(system, dynamics, k, kind, t, y, stages, h, theta_prev, theta, modes, speeds, scratch)
         turning = (r_prev > 0.0 and r < 0.0) if mode == FREE else (r_prev < 0.0 and r > 0.0)
@@ -286,15 +295,24 @@ def first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, frict
 
 
 @njit(cache=True, inline="always")
-def earliest_event(system, dynamics, t, y, y_new, stages, h, points, frictions, modes, speeds, scratch):
-    """(θ, joint, kind) of the step's first event, or (2.0, −1, NORMAL) when there is none."""
+def point_event_value(system, k, kind, kinematics, modes, speeds, friction):
+    """event_value of joint k at one of the step's points from its row of fill_point_kinematics."""
+    return kinematic_event_value(system, k, kind, kinematics[K_PENETRATION], kinematics[K_RATE],
+                                 kinematics[K_SLIDING], modes, speeds, friction)
+
+
+@njit(cache=True, inline="always")
+def earliest_event(system, dynamics, t, y, y_new, stages, h, points, kinematics, frictions, modes, speeds, scratch):
+    """(θ, joint, kind) of the step's first event, or (2.0, −1, NORMAL) when there is none (kinematics: room for
+    fill_point_kinematics, filled here)."""
+    fill_point_kinematics(system, y_new, points, modes, kinematics)
     fill_stick_frictions(system, dynamics, t, y, y_new, h, points, modes, speeds, frictions)
     event_theta = 2.0
     event_joint = np.int64(-1)  # int64 from the start: a literal would compile each callee once more for it
     event_kind = np.int64(NORMAL)
     for k in range(modes.shape[0]):
         for kind in range(2):
-            theta = first_event(system, dynamics, k, kind, t, y, y_new, stages, h, points, frictions, modes, speeds,
+            theta = first_event(system, dynamics, k, kind, t, y, stages, h, kinematics, frictions, modes, speeds,
                                 scratch)
             if theta < event_theta:
                 event_theta, event_joint, event_kind = theta, k, kind
@@ -528,8 +546,34 @@ def fill_subdivisions(y, stages, h, points):
 
 
 @njit(cache=True, inline="always")
-def update_peaks(system, y, stages, h, points, modes, speeds, peak_force, scratch):
-    """Raise peak_force[k] to the largest F_n of the step: at 4 points, then at an interior maximum.
+def fill_point_kinematics(system, y_new, points, modes, kinematics):
+    """kinematics[i, k] ← (δ, δ̇, v_t) of joint k (clearance_kinematics) at the step's point i: its start points[0]
+    (its y bit for bit), its subdivisions, its end y_new, and at EXTENSION_END points[SUBDIVISIONS] for the joints
+    in contact. One evaluation a joint and point for the event search and the peak search, point by point, so that
+    each body's cosine and sine are computed once a point (kept_frame)."""
+    n = coordinate_count(system)
+    for i in range(EXTENSION_END + 1):
+        state = y_new if i == SUBDIVISIONS else points[min(i, SUBDIVISIONS)]
+        for k in range(modes.shape[0]):
+            if i == EXTENSION_END and modes[k] == FREE:
+                continue
+            kin = clearance_kinematics(system, k, state[:n], state[n:2 * n])
+            kinematics[i, k, K_PENETRATION] = kin[4]
+            kinematics[i, k, K_RATE] = kin[5]
+            kinematics[i, k, K_SLIDING] = kin[8]
+
+
+@njit(cache=True, inline="always")
+def point_normal_force(system, k, kinematics, modes, speeds):
+    """F_n of joint k at one of the step's points from its row of fill_point_kinematics (normal_force's bits)."""
+    return contact_force_magnitudes(system, k, kinematics[K_PENETRATION], kinematics[K_RATE], kinematics[K_SLIDING],
+                                    modes[k], speeds[k])[0]
+
+
+@njit(cache=True, inline="always")
+def update_peaks(system, y, stages, h, kinematics, modes, speeds, peak_force, scratch):
+    """Raise peak_force[k] to the largest F_n of the step: at its 5 points on the continuous extension (kinematics:
+    fill_point_kinematics), then at an interior maximum.
 
     A maximum near the sampled one that could raise the peak so far is refined by golden-section
     search on the continuous extension (to 1e-5 of the step), so the peak contact force does not
@@ -541,7 +585,8 @@ def update_peaks(system, y, stages, h, points, modes, speeds, peak_force, scratc
             continue
         best, best_theta = -1.0, 0.0
         for i in range(SUBDIVISIONS + 1):
-            force = normal_force(system, k, points[i], modes, speeds)
+            force = point_normal_force(system, k, kinematics[EXTENSION_END if i == SUBDIVISIONS else i, k], modes,
+                                       speeds)
             if force > best:
                 best, best_theta = force, i / SUBDIVISIONS
         if best < PEAK_CANDIDATE * peak_force[k]:
@@ -688,6 +733,7 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
     scratch = np.empty_like(y)
     points = np.empty((SUBDIVISIONS + 1, y.shape[0]))
     frictions = np.zeros((SUBDIVISIONS + 1, modes.shape[0]))
+    kinematics = np.zeros((EXTENSION_END + 1, modes.shape[0], 3))
     ints[I_STATUS] = RUNNING
     capacity = out_t.shape[0]
     attempts = 0
@@ -752,7 +798,7 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
         ints[I_RHS] += extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints)
         fill_subdivisions(y, stages, h, points)
         event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, points,
-                                                              frictions, modes, speeds, scratch)
+                                                              kinematics, frictions, modes, speeds, scratch)
         if event_joint >= 0:
             jump = jumped_across(system, dynamics, event_joint, event_kind, t, y, stages, h, event_theta, modes, speeds,
                                  scratch)
@@ -761,6 +807,7 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
                              jacobian, jacobian_modes)
             ints[I_RHS] += extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints)
             fill_subdivisions(y, stages, h, points)  # the step integrated again, to the event
+            fill_point_kinematics(system, y_new, points, modes, kinematics)
         emit_samples(system, dynamics, films, projection, implicit_step, t, y, f, stages, h, t + h, modes, speeds,
                      episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
                      scratch)
@@ -770,7 +817,7 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
             if violation > DRIFT_LIMIT:
                 ints[I_STATUS] = DRIFT
                 return
-        update_peaks(system, y, stages, h, points, modes, speeds, peak_force, scratch)
+        update_peaks(system, y, stages, h, kinematics, modes, speeds, peak_force, scratch)
         copy_into(y, y_new)
         real[R_TIME] = t + h if h < real[R_T_END] - t else real[R_T_END]
         ints[I_STEPS] += 1

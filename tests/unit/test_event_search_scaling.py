@@ -9,8 +9,8 @@ import numpy as np
 from numba import njit, objmode, typeof, types
 
 from benchmarks.chain import pendulum_chain
-from clearsim.assembly.dynamics import dry_forces_and_accelerations, dynamics_type
-from clearsim.assembly.forces import CONTACT, STICK
+from clearsim.assembly.dynamics import coordinate_count, dry_forces_and_accelerations, dynamics_type
+from clearsim.assembly.forces import CONTACT, STICK, clearance_kinematics
 from clearsim.model.loader import load_mechanism_text
 from clearsim.runner import prepare
 from clearsim.solver import integrator as ig
@@ -47,7 +47,9 @@ def _reserves(system, dynamics, y, modes, speeds):
     ig.stick_frictions(system, dynamics, 0.0, y, modes, speeds, frictions)
     shared, alone = np.zeros(modes.shape[0]), np.zeros(modes.shape[0])
     for k in range(modes.shape[0]):
-        shared[k] = ig.reserve_left(system, k, y, modes, speeds, frictions[k])[0]
+        n = coordinate_count(system)
+        kin = clearance_kinematics(system, k, y[:n], y[n:2 * n])
+        shared[k] = ig.reserve_left(system, k, kin[4], kin[5], kin[8], modes, speeds, frictions[k])[0]
         alone[k] = ig.friction_reserve(system, dynamics, 0.0, y, modes, speeds, k)[0]
     return shared, alone
 
@@ -61,8 +63,9 @@ def _values(system, dynamics, k, kind, y, stages, h, theta, modes, speeds, scrat
 def _earliest(system, dynamics, t, y, stages, h, modes, speeds):
     points = np.empty((ig.SUBDIVISIONS + 1, y.shape[0]))
     frictions = np.zeros((ig.SUBDIVISIONS + 1, modes.shape[0]))
+    kinematics = np.empty((ig.EXTENSION_END + 1, modes.shape[0], 3))
     ig.fill_subdivisions(y, stages, h, points)
-    return ig.earliest_event(system, dynamics, t, y, y, stages, h, points, frictions, modes, speeds,
+    return ig.earliest_event(system, dynamics, t, y, y, stages, h, points, kinematics, frictions, modes, speeds,
                              np.empty_like(y))
 
 
@@ -122,3 +125,23 @@ def test_the_searches_interpolate_only_the_joints_two_bodies():
 def system_bodies(run: Run, k: int) -> tuple[int, int]:
     """The (bearing, journal) bodies of clearance joint k."""
     return tuple(int(b) for b in run.system.arrays.clearance_bodies[k])
+
+
+def test_each_points_kinematics_serve_the_event_values_and_the_peak_force_bit_for_bit():
+    """fill_point_kinematics evaluates each joint once a point; the event search and the peak search read it."""
+    system, y, stages, modes, speeds = state(chain_run(), CONTACT)
+    modes[::2] = STICK  # every other joint sticking (its F_t given), the others sliding
+    points = np.empty((ig.SUBDIVISIONS + 1, y.shape[0]))
+    ig.fill_subdivisions(y, stages, 1e-4, points)
+    y_new = points[ig.SUBDIVISIONS] + 1e-9  # the step's end, a little off the extension's, as after the step
+    kinematics = np.full((ig.EXTENSION_END + 1, modes.shape[0], 3), np.nan)
+    ig.fill_point_kinematics(system, y_new, points, modes, kinematics)
+    states = [*points[:ig.SUBDIVISIONS], y_new, points[ig.SUBDIVISIONS]]
+    assert np.array_equal(points[0], y)
+    for i, point in enumerate(states):
+        for k in range(modes.shape[0]):
+            for kind in (ig.NORMAL, ig.TANGENTIAL):
+                expected = ig.event_value(system, dry_forces_and_accelerations, k, kind, 0.0, point, modes, speeds, 7.0)
+                assert ig.point_event_value(system, k, kind, kinematics[i, k], modes, speeds, 7.0) == expected
+            assert ig.point_normal_force(system, k, kinematics[i, k], modes, speeds) == ig.normal_force(
+                system, k, point, modes, speeds)

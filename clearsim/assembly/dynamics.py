@@ -419,8 +419,9 @@ def project_positions(system, t, q, modes, tolerance, max_iterations):
     phi = system.solve_residual[:m]
     for _ in range(max_iterations):
         evaluate_constraints(system, t, q, phi)
-        if largest_magnitude(phi) <= tolerance:
-            break
+        violation = largest_magnitude(phi)
+        if violation <= tolerance:
+            return violation
         blocks, bodies = factored_jacobian(system, q, q, modes, m, phi)
         subtract_minimum_norm_correction(system, blocks, bodies, phi, q)
     evaluate_constraints(system, t, q, phi)
@@ -441,17 +442,6 @@ def project_velocities(system, t, q, qd, modes):
     for r in range(m):
         residual[r] -= nu[r]
     subtract_minimum_norm_correction(system, blocks, bodies, residual, qd)
-
-
-@njit(cache=True)
-def constraint_violation(system, t, q):
-    """max |Φ(q, t)| (m or rad)."""
-    m = constraint_count(system)
-    if m == 0:
-        return 0.0
-    phi = np.empty(m)
-    evaluate_constraints(system, t, q, phi)
-    return largest_magnitude(phi)
 
 
 @njit(cache=True, inline="always")

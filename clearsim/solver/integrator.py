@@ -371,14 +371,14 @@ def emit_samples(system, dynamics, films, projection, implicit_step, t, y, f, st
             interpolate(y, stages, h, (sample_time - t) / h, scratch)
         else:
             copy_into(scratch, y)
-        projection(system, sample_time, scratch, modes)
+        violation = projection(system, sample_time, scratch, modes)
         out_t[row] = sample_time
         copy_into(out_y[row], scratch)
         copy_into(out_modes[row], modes)
         copy_into(out_speeds[row], speeds)
         copy_into(out_episode[row], episode_of)
-        derive_sample(system, dynamics, films, sample_time, scratch, modes, speeds, out_qdd[row], out_lam[row],
-                      out_contact[row], out_energies[row])
+        derive_sample(system, dynamics, films, sample_time, scratch, violation, modes, speeds, out_qdd[row],
+                      out_lam[row], out_contact[row], out_energies[row])
         if chained:
             origin_t, origin_y, origin_f = sample_time, scratch.copy(), np.empty_like(f)
             rhs(system, dynamics, sample_time, origin_y, modes, speeds, origin_f)

@@ -53,7 +53,7 @@ FILMS = object()  # stands for films_type(system_type())
 # search, the peak search). Then come the kernels `advance` takes by address (kernels_ahead).
 AHEAD = (
     ("clearsim.solver.integrator", "event_value", (D, I, I, F, V, IV, V, F)),
-    ("clearsim.solver.samples", "derive_sample", (D, FILMS, F, V, IV, V, V, V, M, V)),
+    ("clearsim.solver.samples", "derive_sample", (D, FILMS, F, V, F, IV, V, V, V, M, V)),
     ("clearsim.solver.integrator", "_value_at", (D, I, I, F, V, M, F, F, IV, V, V)),
     ("clearsim.solver.integrator", "normal_force_at", (I, V, M, F, F, IV, V, V)),
 )

@@ -9,9 +9,7 @@ from numba import njit
 
 from clearsim.assembly.arrays import CL_CLEARANCE, CL_VISCOSITY, copy_into
 from clearsim.assembly.constraints import constraint_count
-from clearsim.assembly.dynamics import (
-    constraint_violation, coordinate_count, element_states,
-)
+from clearsim.assembly.dynamics import coordinate_count, element_states
 from clearsim.assembly.forces import FREE, STICK, clearance_kinematics, contact_force_magnitudes, potential_energy
 
 # columns of the per-joint contact output; the film's (a lubricated joint's oil film, zero while the dry laws act)
@@ -23,9 +21,10 @@ ENERGY_FIELDS = 3
 
 
 @njit(cache=True)
-def derive_sample(system, dynamics, films, t, state, modes, speeds, qdd, lam, contact, energies):
+def derive_sample(system, dynamics, films, t, state, violation, modes, speeds, qdd, lam, contact, energies):
     """One sample's q̈ and λ into qdd and lam, its contact fields (nc, CONTACT_FIELDS) into contact, and (kinetic,
-    potential, violation) into energies; `films` the oil films' forces, by address (dynamics.films_kernel)."""
+    potential, violation) into energies; violation: max |Φ| at the state (its projection's), `films` the oil films'
+    forces, by address (dynamics.films_kernel)."""
     n = coordinate_count(system)
     m = constraint_count(system)
     q = state[:n].copy()
@@ -55,4 +54,4 @@ def derive_sample(system, dynamics, films, t, state, modes, speeds, qdd, lam, co
                           + system.inertia[b] * qd[3 * b + 2] ** 2)
     energies[E_KINETIC] = kinetic
     energies[E_POTENTIAL] = potential_energy(system, q)
-    energies[E_VIOLATION] = constraint_violation(system, t, q)
+    energies[E_VIOLATION] = violation

@@ -486,10 +486,6 @@ class History:
     status: str
 
 
-def join_chunks(chunks: list[Chunk]) -> Chunk:
-    return Chunk(*(np.concatenate([getattr(c, name) for c in chunks]) for name in Chunk.__dataclass_fields__))
-
-
 def simulate(system: System, progress: Callable[[float], None] | None = None,
              warn: Callable[[str], None] | None = None) -> History:
     """Run to t_end and return the History; SolverError propagates (use Run.chunks to keep partial results)."""
@@ -497,4 +493,4 @@ def simulate(system: System, progress: Callable[[float], None] | None = None,
     chunks = []
     for chunk in run.chunks(progress):
         chunks.append(chunk)
-    return History(system, join_chunks(chunks), run.episode_log(), run.statistics(), True, "complete")
+    return History(system, Chunk.joined(chunks), run.episode_log(), run.statistics(), True, "complete")

@@ -1,4 +1,4 @@
-"""A sample's recorded constraint violation (the `violation` history, docs/model.md §8) is max |Φ(q, t)| of the very
+"""A sample's recorded constraint violation (`/constraints/violation`, docs/model.md "Stabilisation") is max |Φ(q, t)| of the very
 state it records: its projection's last evaluation, not recomputed and not one taken before the projection's last
 correction."""
 

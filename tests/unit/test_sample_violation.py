@@ -1,6 +1,6 @@
-"""A sample's recorded constraint violation (`/constraints/violation`, docs/model.md "Stabilisation") is max |Φ(q, t)| of the very
-state it records: its projection's last evaluation, not recomputed and not one taken before the projection's last
-correction."""
+"""A sample's recorded constraint violation (`/constraints/violation`, docs/model.md "Stabilisation") is max |Φ(q, t)|
+of the very state it records: its projection's last evaluation, not recomputed and not one taken before the
+projection's last correction."""
 
 import numpy as np
 

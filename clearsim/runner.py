@@ -143,6 +143,7 @@ def _final_attributes(run: Run, warnings: list[str]) -> dict:
             "rhs_evaluations": stats.rhs_evaluations, "contact_events": stats.contact_events,
             "max_step_violation": stats.max_violation, "simulated_time_s": run.time,
             "tolerance_over_penetration": stats.tolerance_over_penetration,
+            "penetration_guard_rejections": stats.penetration_rejections,
             "peak_output_acceleration": stats.peak_output_acceleration, "warnings": "\n".join(warnings)}
 
 

@@ -71,7 +71,9 @@ REAL_SLOTS = 17
 I_METHOD, I_JACOBIAN_AGE = 14, 15
 # the states at the end of y that steer no step (dynamics.wear_state_count: fixed at assembly, set once per call)
 I_UNSTEERING_TAIL = 16
-INT_SLOTS = 17
+# the tries rejected by the penetration guard alone (penetration_error_ratio)
+I_PENETRATION_REJECTED = 17
+INT_SLOTS = 18
 DOPRI5, ROSENBROCK, DOP853 = range(3)
 DOPRI5_ERROR_ORDER = 4  # DOPRI5's embedded solution
 METHODS = {"dopri5": DOPRI5, "rosenbrock": ROSENBROCK, "dop853": DOP853}
@@ -100,6 +102,7 @@ DECIDE_SPEED = 1e-6  # m/s: below it a contact tests whether it sticks (settle_f
 JUMP_WIDENING = 1e-6  # of the event step: its first lengthening past a jump of the sliding speed (refine_event)
 DEEPEST_PENETRATION = 0.05  # of the journal radius: beyond it no contact law means anything
 UNRESOLVED_RATIO = 3.0  # position tolerance over an impact's Hertz penetration above which a run warns (model.md §4)
+PENETRATION_ERROR_SHARE = 0.01  # of the penetration: the largest error estimate a step may leave in a contact's δ
 
 
 @njit(cache=True)
@@ -631,18 +634,55 @@ def update_output_peak(n, y, f, real):
 def method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stages, y_new, real, ints, jacobian,
                 jacobian_modes, take_jacobian):
     """One step of the run's method (ints[I_METHOD]); ROSENBROCK: by address (rosenbrock.attempt), J taken anew first
-    when take_jacobian. Returns (the error norm, the rhs evaluations made)."""
+    when take_jacobian. Returns (the error norm, the rhs evaluations made, the error estimate e, the weight w that
+    makes w·e the estimate the norm measures: 1, or DOP853's combined over its 5th-order one)."""
     if ints[I_METHOD] == ROSENBROCK:
         error = implicit_step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian, jacobian_modes,
                               take_jacobian, real[R_ATOL] / real[R_RTOL])
         taken = rosenbrock.jacobian_evaluations(jacobian_modes) if take_jacobian else 0
-        return steering_norm(system, error, y, y_new, real, ints), rosenbrock.STAGES + taken
+        return steering_norm(system, error, y, y_new, real, ints), rosenbrock.STAGES + taken, error, 1.0
     if ints[I_METHOD] == DOP853:
         high, low = dop853.step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new)
-        return (dop853.combined_norm(steering_norm(system, high, y, y_new, real, ints),
-                                     steering_norm(system, low, y, y_new, real, ints)), dop853.TRIAL_EVALUATIONS)
-    return steering_norm(system, step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new), y, y_new, real,
-                         ints), 6
+        high_norm = steering_norm(system, high, y, y_new, real, ints)
+        norm = dop853.combined_norm(high_norm, steering_norm(system, low, y, y_new, real, ints))
+        return norm, dop853.TRIAL_EVALUATIONS, high, norm / high_norm if high_norm > 0.0 else 0.0
+    error = step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new)
+    return steering_norm(system, error, y, y_new, real, ints), 6, error, 1.0
+
+
+@njit(cache=True, inline="always")
+def guarded_norm(system, norm, error, weight, y, y_new, modes, real, ints):
+    """The step's error norm, or the penetration guard's ratio where that rejects a try the norm would accept: a try
+    whose estimated error (weight · error) in a contacting joint's penetration exceeds PENETRATION_ERROR_SHARE of the
+    penetration (penetration_error_ratio) is taken again shorter, whatever the tolerance (model.md §4)."""
+    ratio = weight * penetration_error_ratio(system, error, y, y_new, modes, real[R_ATOL])
+    if ratio <= 1.0 or ratio <= norm:
+        return norm
+    if norm <= 1.0:
+        ints[I_PENETRATION_REJECTED] += 1
+    return ratio
+
+
+@njit(cache=True)
+def penetration_error_ratio(system, error, y, y_new, modes, atol):
+    """max over the joints in contact of |δ(q_new) − δ(q_new − e_q)| / (PENETRATION_ERROR_SHARE · max(δ(q), δ(q_new),
+    atol)): the step's error estimate e carried into each contacting joint's penetration, against a share of the
+    penetration itself (0 with no joint in contact)."""
+    n = coordinate_count(system)
+    worst = 0.0
+    shifted = np.empty(0)
+    for k in range(modes.shape[0]):
+        if modes[k] == FREE:
+            continue
+        if shifted.shape[0] == 0:
+            shifted = np.empty(n)
+            for i in range(n):
+                shifted[i] = y_new[i] - error[i]
+        start = clearance_kinematics(system, k, y[:n], y[n:2 * n])[4]
+        end = clearance_kinematics(system, k, y_new[:n], y_new[n:2 * n])[4]
+        estimated = clearance_kinematics(system, k, shifted, y_new[n:2 * n])[4]
+        worst = max(worst, abs(end - estimated) / (PENETRATION_ERROR_SHARE * max(start, end, atol)))
+    return worst
 
 
 @njit(cache=True, inline="always")
@@ -777,8 +817,9 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
                 return
             h = (capacity - 2) * real[R_SAMPLE_DT]
         take_jacobian = jacobian_due(ints, modes, jacobian_modes)
-        norm, evaluations = method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stages, y_new, real,
-                                        ints, jacobian, jacobian_modes, take_jacobian)
+        norm, evaluations, error, weight = method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stages,
+                                                       y_new, real, ints, jacobian, jacobian_modes, take_jacobian)
+        norm = guarded_norm(system, norm, error, weight, y, y_new, modes, real, ints)
         ints[I_RHS] += evaluations
         if take_jacobian:
             ints[I_JACOBIAN_AGE] = 0

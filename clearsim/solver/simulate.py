@@ -81,6 +81,7 @@ class Statistics:
     peak_normal_force: np.ndarray = field(default_factory=lambda: np.zeros(0))
     peak_output_acceleration: float = 0.0  # |output.acceleration| at every step's end (0: no such sensor)
     tolerance_over_penetration: float = 0.0  # largest over the contact onsets (docs/model.md §4)
+    penetration_rejections: int = 0  # tries the penetration guard alone rejected (docs/model.md §4)
 
 
 @dataclass
@@ -295,6 +296,7 @@ class Run:
         return Statistics(
             steps=int(self.ints[ig.I_STEPS]), rejected_steps=int(self.ints[ig.I_REJECTED]),
             rhs_evaluations=int(self.ints[ig.I_RHS]), contact_events=int(self.ints[ig.I_EVENTS]),
+            penetration_rejections=int(self.ints[ig.I_PENETRATION_REJECTED]),
             max_violation=float(self.real[ig.R_VIOLATION]), wall_time=self.wall_time, kernel_time=self.kernel_time,
             kernels_compiled=self.kernels_compiled,
             peak_normal_force=self.peak_force.copy(), tolerance_over_penetration=float(self.real[ig.R_COARSE_RATIO]),

@@ -149,7 +149,7 @@ def clearsim_first_impact(config: Path, t_end: float) -> tuple[float, float]:
     from clearsim.runner import prepare
     from clearsim.solver.simulate import Run
 
-    run = Run(prepare(load_mechanism(config, [f"solver.t_end={t_end!r}"])))
+    run = Run(prepare(load_mechanism(config, [f"solver.t_end={t_end!r}s"])))
     for _chunk in run.chunks():
         pass
     return float(run.episode_log().onset[0]), float(run.statistics().peak_normal_force.max())

@@ -128,3 +128,16 @@ def test_the_sweep_keep_benchmark_compares_equal_summaries_and_the_file_sizes(tm
     assert summary["mb_per_case"] < full["mb_per_case"]
     assert full["cases_per_minute"] == pytest.approx(60.0 * 2 / full["wall_median_s"])
     assert "same summary: True" in describe("sweep-keep", result)
+
+
+def test_clearsims_side_of_the_first_impact_check_matches_the_minimal_model():
+    """The peer study's first-impact check without the peer (which CI does not install): clearsim's onset and peak
+    contact force of the slider-crank's first impact against the independent minimal-coordinate model."""
+    from benchmarks.suite import CRANK, clearsim_first_impact
+    from tests.support.slider_crank_minimal import FRICTIONLESS
+    from tests.support.slider_crank_minimal import simulate as minimal
+
+    onset, force = clearsim_first_impact(CRANK, 4e-4)
+    exact = minimal(FRICTIONLESS, t_end=4e-4, rtol=1e-11).episodes[0]
+    assert onset == pytest.approx(exact.onset, rel=1e-9)
+    assert force == pytest.approx(exact.peak_normal_force, rel=1e-6)

@@ -9,6 +9,14 @@ __version__ = "0.1.0"
 COMPILED_PACKAGES = ("assembly", "physics", "solver")  # the modules with numba kernels
 
 
+def cache_home() -> Path:
+    """clearsim's cache folder: $XDG_CACHE_HOME/clearsim, or ~/.cache/clearsim where the variable is unset, empty or
+    relative (the XDG base directory specification: a relative path is invalid and is ignored)."""
+    configured = os.environ.get("XDG_CACHE_HOME", "")
+    base = Path(configured) if configured and Path(configured).is_absolute() else Path.home() / ".cache"
+    return base / "clearsim"
+
+
 def _kernel_cache_dir() -> str:
     """A numba cache folder keyed by the source of every compiled module.
 
@@ -21,8 +29,7 @@ def _kernel_cache_dir() -> str:
     for folder in COMPILED_PACKAGES:
         for source in sorted((package / folder).glob("*.py")):
             digest.update(source.read_bytes())
-    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "clearsim" / "numba"
-    return str(base / digest.hexdigest()[:16])
+    return str(cache_home() / "numba" / digest.hexdigest()[:16])
 
 
 os.environ.setdefault("NUMBA_CACHE_DIR", _kernel_cache_dir())

@@ -10,7 +10,6 @@ radian, newton). Angles are dimensionless in SI, so "5000 rpm" converts to rad/s
 from __future__ import annotations
 
 import math
-import os
 import re
 from dataclasses import dataclass
 from functools import lru_cache
@@ -18,6 +17,8 @@ from pathlib import Path
 from typing import Annotated, Any
 
 from pydantic import BeforeValidator, ValidationInfo, WithJsonSchema
+
+from clearsim import cache_home
 
 
 class UnitError(ValueError):
@@ -31,7 +32,7 @@ def registry():
 
 
 def _pint_cache_folder() -> Path:
-    return Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "clearsim" / "pint"
+    return cache_home() / "pint"
 
 
 def new_registry(cache_folder: Path | None):

@@ -27,3 +27,19 @@ def test_every_kernel_is_cached_in_clearsims_folder(order):
     folder, index = done.stdout.split()
     assert os.path.join("clearsim", "numba") in folder
     assert index.startswith(folder + os.sep)
+
+
+@pytest.mark.parametrize("configured, expected", [
+    ("", os.path.join(os.path.expanduser("~"), ".cache", "clearsim")),  # empty: unset (XDG base directory spec)
+    ("relative/cache", os.path.join(os.path.expanduser("~"), ".cache", "clearsim")),  # relative: invalid, ignored
+    (os.path.join(os.sep, "srv", "cache"), os.path.join(os.sep, "srv", "cache", "clearsim")),
+])
+def test_the_cache_home_follows_the_xdg_rules(monkeypatch, configured, expected):
+    """An empty or relative XDG_CACHE_HOME once put the kernel and unit caches under ./clearsim of whatever folder a
+    run started in."""
+    from clearsim import cache_home
+    from clearsim.units import _pint_cache_folder
+
+    monkeypatch.setenv("XDG_CACHE_HOME", configured)
+    assert str(cache_home()) == expected
+    assert str(_pint_cache_folder()) == os.path.join(expected, "pint")

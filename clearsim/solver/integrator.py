@@ -656,7 +656,7 @@ def guarded_norm(system, norm, error, weight, y, y_new, modes, real, ints):
     whose estimated error (weight · error) in a contacting joint's penetration exceeds PENETRATION_ERROR_SHARE of the
     penetration (penetration_error_ratio) is taken again shorter, whatever the tolerance (model.md §4)."""
     ratio = weight * penetration_error_ratio(system, error, y, y_new, modes, real[R_ATOL])
-    if ratio <= 1.0 or ratio <= norm:
+    if not ratio > max(norm, 1.0):  # within the share, or no larger than the norm; a NaN on either side: the norm's
         return norm
     if norm <= 1.0:
         ints[I_PENETRATION_REJECTED] += 1

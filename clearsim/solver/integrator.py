@@ -651,11 +651,12 @@ def method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stag
 
 
 @njit(cache=True, inline="always")
-def guarded_norm(system, norm, error, weight, y, y_new, modes, real, ints):
+def guarded_norm(system, norm, error, weight, y, y_new, modes, real, ints, scratch):
     """The step's error norm, or the penetration guard's ratio where that rejects a try the norm would accept: a try
     whose estimated error (weight · error) in a contacting joint's penetration exceeds PENETRATION_ERROR_SHARE of the
-    penetration (penetration_error_ratio) is taken again shorter, whatever the tolerance (model.md §4)."""
-    ratio = weight * penetration_error_ratio(system, error, y, y_new, modes, real[R_ATOL])
+    penetration (penetration_error_ratio) is taken again shorter, whatever the tolerance (model.md §4). scratch: room
+    for a state."""
+    ratio = weight * penetration_error_ratio(system, error, y, y_new, modes, real[R_ATOL], scratch)
     if not ratio > max(norm, 1.0):  # within the share, or no larger than the norm; a NaN on either side: the norm's
         return norm
     if norm <= 1.0:
@@ -664,23 +665,20 @@ def guarded_norm(system, norm, error, weight, y, y_new, modes, real, ints):
 
 
 @njit(cache=True)
-def penetration_error_ratio(system, error, y, y_new, modes, atol):
+def penetration_error_ratio(system, error, y, y_new, modes, atol, shifted):
     """max over the joints in contact of |δ(q_new) − δ(q_new − e_q)| / (PENETRATION_ERROR_SHARE · max(δ(q), δ(q_new),
     atol)): the step's error estimate e carried into each contacting joint's penetration, against a share of the
-    penetration itself (0 with no joint in contact)."""
+    penetration itself (0 with no joint in contact); shifted: room for q_new − e_q."""
     n = coordinate_count(system)
+    for i in range(n):
+        shifted[i] = y_new[i] - error[i]
     worst = 0.0
-    shifted = np.empty(0)
     for k in range(modes.shape[0]):
         if modes[k] == FREE:
             continue
-        if shifted.shape[0] == 0:
-            shifted = np.empty(n)
-            for i in range(n):
-                shifted[i] = y_new[i] - error[i]
         start = clearance_kinematics(system, k, y[:n], y[n:2 * n])[4]
         end = clearance_kinematics(system, k, y_new[:n], y_new[n:2 * n])[4]
-        estimated = clearance_kinematics(system, k, shifted, y_new[n:2 * n])[4]
+        estimated = clearance_kinematics(system, k, shifted[:n], y_new[n:2 * n])[4]
         worst = max(worst, abs(end - estimated) / (PENETRATION_ERROR_SHARE * max(start, end, atol)))
     return worst
 
@@ -819,7 +817,7 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
         take_jacobian = jacobian_due(ints, modes, jacobian_modes)
         norm, evaluations, error, weight = method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stages,
                                                        y_new, real, ints, jacobian, jacobian_modes, take_jacobian)
-        norm = guarded_norm(system, norm, error, weight, y, y_new, modes, real, ints)
+        norm = guarded_norm(system, norm, error, weight, y, y_new, modes, real, ints, scratch)
         ints[I_RHS] += evaluations
         if take_jacobian:
             ints[I_JACOBIAN_AGE] = 0

@@ -654,14 +654,17 @@ def method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stag
 def guarded_norm(system, norm, error, weight, y, y_new, modes, real, ints, scratch):
     """The step's error norm, or the penetration guard's ratio where that rejects a try the norm would accept: a try
     whose estimated error (weight · error) in a contacting joint's penetration exceeds PENETRATION_ERROR_SHARE of the
-    penetration (penetration_error_ratio) is taken again shorter, whatever the tolerance (model.md §4). scratch: room
-    for a state."""
+    penetration (penetration_error_ratio) is taken again shorter, whatever the tolerance (model.md §4). Once the guard
+    has rejected a try in the run, the larger of the two measures every try, so that the next step is proposed for
+    the guard too; until then (every default run of the bundled models) the norm alone. scratch: room for a state."""
     ratio = weight * penetration_error_ratio(system, error, y, y_new, modes, real[R_ATOL], scratch)
-    if not ratio > max(norm, 1.0):  # within the share, or no larger than the norm; a NaN on either side: the norm's
-        return norm
-    if norm <= 1.0:
-        ints[I_PENETRATION_REJECTED] += 1
-    return ratio
+    if ratio > max(norm, 1.0):
+        if norm <= 1.0:
+            ints[I_PENETRATION_REJECTED] += 1
+        return ratio
+    if ratio > norm and ints[I_PENETRATION_REJECTED] > 0:
+        return ratio  # the guard has rejected a try in this run: it steers the steps from then on
+    return norm  # within the share, or no larger than the norm; a NaN on either side: the norm's
 
 
 @njit(cache=True)

@@ -69,3 +69,42 @@ def test_the_penetration_guard_resolves_an_impact_a_loose_tolerance_would_flatte
 def solver_warnings(warnings: list[str]) -> list[str]:
     """All but the whirl of a journal, a warning about the model (the UHV's J whirls: tests/validation/test_whirl.py)."""
     return [line for line in warnings if "whirls around its bearing" not in line]
+
+
+def test_once_the_guard_has_rejected_a_try_it_steers_the_steps():
+    """A try within the tolerance and within the guard's share is measured by the tolerance norm alone until the
+    guard has rejected a try in the run (the default runs' steps stay those of the norm); from then on by the larger
+    of the norm and the guard's ratio, so the step after a guarded one is proposed short enough for the guard
+    instead of being tried at the norm's length and rejected (model.md §4)."""
+    import numpy as np
+
+    from clearsim.solver import integrator as ig
+    from clearsim.solver.simulate import Run
+
+    loaded = load_mechanism(CONFIGS / "slider_crank_flores.yaml", ["solver.t_end=0.235ms"])  # inside the first impact
+    run = Run(prepare(loaded))
+    for _chunk in run.chunks():
+        pass
+    assert run.modes.max() > 0  # the journal is in contact
+    journal = run.system.arrays.clearance_bodies[0, 1]
+    unit = np.zeros_like(run.y)
+    unit[3 * journal:3 * journal + 2] = 1e-9  # a position error of the journal's centre
+    scratch = np.empty_like(run.y)
+    per_unit = ig.penetration_error_ratio(run.kernel_arrays, unit, run.y, run.y, run.modes, run.real[ig.R_ATOL],
+                                          scratch)
+    assert per_unit > 0.0
+    error = unit * (0.5 / per_unit)  # the guard's ratio ≈ 0.5: within its share
+    ratio = ig.penetration_error_ratio(run.kernel_arrays, error, run.y, run.y, run.modes, run.real[ig.R_ATOL], scratch)
+    assert 0.4 < ratio < 0.6
+    ints = np.zeros(ig.INT_SLOTS, np.int64)
+
+    def guarded(norm):
+        return ig.guarded_norm(run.kernel_arrays, norm, error, 1.0, run.y, run.y, run.modes, run.real, ints, scratch)
+
+    assert guarded(0.1) == 0.1  # no guard rejection yet: the norm's
+    assert guarded(2.0) == 2.0  # the norm rejects; the guard does not count it
+    assert ints[ig.I_PENETRATION_REJECTED] == 0
+    ints[ig.I_PENETRATION_REJECTED] = 1  # the guard has rejected a try in this run
+    assert guarded(0.1) == ratio  # the guard's ratio steers
+    assert guarded(0.7) == 0.7  # the norm where it is the larger
+    assert ints[ig.I_PENETRATION_REJECTED] == 1

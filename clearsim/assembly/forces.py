@@ -83,9 +83,7 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
     wb = body_rates(qd, bearing)[2]
     c, s = np.cos(angle), np.sin(angle)
     local_x, local_y = c * ex + s * ey, -s * ex + c * ey
-    _, rx, ry, tangent_x, tangent_y, curvature = system.bore_point(  # wear.nearest_bore_point, by address
-        system.wear_profile[k], system.wear_harmonics[k], system.wear_depth_range[k], system.wear_bounds[k, WEAR_REACH],
-        system.wear_bounds[k, WEAR_INNERMOST], p[CL_BEARING_RADIUS], local_x, local_y)
+    rx, ry, tangent_x, tangent_y, curvature = nearest_point_kept(system, k, local_x, local_y)
     gap_x, gap_y = rx - local_x, ry - local_y
     distance = np.sqrt(gap_x * gap_x + gap_y * gap_y)
     local_nx, local_ny = gap_x / distance, gap_y / distance
@@ -103,6 +101,25 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
     normal_turn = wb + ((-local_ny * tangent_x + local_nx * tangent_y) * foot_rate
                         - (-local_ny * local_rate_x + local_nx * local_rate_y)) / distance
     return p[CL_JOURNAL_RADIUS] - distance, rate, nx, ny, sliding, arm_x, arm_y, normal_turn
+
+
+@njit(cache=True, inline="always")
+def nearest_point_kept(system, k, local_x, local_y):
+    """(r_x, r_y, t_x, t_y, ρ'') of joint k's worn bore nearest to the journal centre (local_x, local_y) in the bearing
+    frame (wear.nearest_bore_point, by address), kept in system.bore_memo and found again only when that centre
+    changes bit for bit (and at a zero coordinate, whose sign the angle of e reads): the forces, the wear rates and
+    the stick row of one state share one search. The bore's profile is fixed for the arrays' life."""
+    memo = system.bore_memo[k]
+    if memo[0] != local_x or memo[1] != local_y or local_x == 0.0 or local_y == 0.0:
+        p = system.clearance_params[k]
+        found = system.bore_point(  # wear.nearest_bore_point, by address
+            system.wear_profile[k], system.wear_harmonics[k], system.wear_depth_range[k],
+            system.wear_bounds[k, WEAR_REACH], system.wear_bounds[k, WEAR_INNERMOST], p[CL_BEARING_RADIUS], local_x,
+            local_y)
+        memo[0], memo[1] = local_x, local_y
+        for i in range(6):
+            memo[2 + i] = found[i]
+    return memo[3], memo[4], memo[5], memo[6], memo[7]
 
 
 @njit(cache=True)

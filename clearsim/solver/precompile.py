@@ -80,7 +80,7 @@ FIELD_LAYOUT = {
     "solve_next_row": ("i8", 1), "solve_body_start": ("i8", 1),
     "solve_entries": ("i8", 2), "solve_body_fill": ("i8", 1), "solve_vector": ("f8", 1),
     "solve_residual": ("f8", 1), "solve_place": ("i8", 1), "solve_placed": ("f8", 1), "factor_key": ("i8", 1), "factor_q": ("f8", 1),
-    "frame_trig": ("f8", 2),
+    "frame_trig": ("f8", 2), "bore_memo": ("f8", 2),
 }
 
 _helper: subprocess.Popen | None = None

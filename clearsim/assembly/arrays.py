@@ -144,8 +144,8 @@ WORKSPACE_FIELDS = [
     "factor_key",  # (1 + nc,) what solve_lower holds: none / positive definite / not; which joints have stick rows
     "factor_q",  # (3 nb,) the q it was computed at
     "frame_trig",  # (nb, 3) θ, cos θ, sin θ of each body at the θ last seen (kinematics.kept_frame); θ NaN: none yet
-    "bore_memo",  # (nc, 8) a worn bore's journal centre last seen in its bearing frame and its nearest point there
-    # (forces.worn_contact: x, y, then bore_point's six values; x NaN: none yet)
+    "bore_memo",  # (nc, 14) a worn bore's journal centre last seen in its bearing frame, its nearest point there
+    # and the second rim it touches (forces.kept_bore_points: x, y, then bore_point's twelve values; x NaN: none yet)
 ]
 
 
@@ -180,7 +180,7 @@ def _workspace(arrays: SystemArrays) -> tuple:
             np.zeros(bodies + 1, np.int64),
             np.zeros((2 * rows, 2), np.int64), np.zeros(bodies, np.int64), np.zeros(3 * bodies), np.zeros(rows),
             places, np.zeros(rows), np.zeros(1 + arrays.clearance_bodies.shape[0], np.int64), np.zeros(3 * bodies),
-            np.full((bodies, 3), np.nan), np.full((arrays.clearance_bodies.shape[0], 8), np.nan))
+            np.full((bodies, 3), np.nan), np.full((arrays.clearance_bodies.shape[0], 14), np.nan))
 
 
 def for_kernels(arrays: SystemArrays) -> KernelArrays:

@@ -77,13 +77,52 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
     its rate global: the journal touches the bore at its point r closest to P_J (r from P_B, global), with the bore's
     normal n there; δ = R_J − |r − e|, δ̇ = n·(ė − ω_B k×r), v_t = t·(ė − ω_B k×r) + ω_J R_J, and ψ̇ the rate at
     which n turns (docs/model-contact.md, "Worn bores and Archard wear")."""
-    p = system.clearance_params[k]
+    c, s, wb, local_x, local_y = bearing_view(system, k, q, qd, ex, ey)
+    rx, ry, tangent_x, tangent_y, curvature = nearest_point_kept(system, k, local_x, local_y)
+    penetration, rate, nx, ny, sliding, arm_x, arm_y, local_nx, local_ny, distance = rim_contact(
+        system, k, qd, c, s, wb, local_x, local_y, dex, dey, rx, ry)
+    frame_x, frame_y = dex + wb * ey, dey - wb * ex  # ė − ω_B k×e, turned into the bearing frame below
+    local_rate_x, local_rate_y = c * frame_x + s * frame_y, -s * frame_x + c * frame_y
+    foot_rate = 0.0  # θ̇* of the closest point (none where it is not a minimum: free flight near the centre)
+    if curvature > 0.0:
+        foot_rate = (tangent_x * local_rate_x + tangent_y * local_rate_y) / curvature
+    normal_turn = wb + ((-local_ny * tangent_x + local_nx * tangent_y) * foot_rate
+                        - (-local_ny * local_rate_x + local_nx * local_rate_y)) / distance
+    return penetration, rate, nx, ny, sliding, arm_x, arm_y, normal_turn
+
+
+@njit(cache=True)
+def second_rim(system, k, q, qd, ex, ey, dex, dey):
+    """(δ, δ̇, n_x, n_y, v_t, r_x, r_y) of the second rim joint k's journal touches in a worn bore tighter than
+    itself (wear.second_foot), as worn_contact's of the nearest point (δ measured as the joint's: from its dry gap);
+    δ = −inf where there is none (docs/model-contact.md, "A pocket tighter than the journal")."""
+    if system.wear_harmonics[k] <= 0:
+        return -np.inf, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0
+    c, s, wb, local_x, local_y = bearing_view(system, k, q, qd, ex, ey)
+    rim, rx, ry = second_point_kept(system, k, local_x, local_y)
+    if not rim == rim:
+        return -np.inf, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0
+    penetration, rate, nx, ny, sliding, arm_x, arm_y = rim_contact(system, k, qd, c, s, wb, local_x, local_y, dex, dey,
+                                                                   rx, ry)[:7]
+    return penetration + system.clearance_params[k, CL_DRY_GAP], rate, nx, ny, sliding, arm_x, arm_y
+
+
+@njit(cache=True, inline="always")
+def bearing_view(system, k, q, qd, ex, ey):
+    """(cos θ_B, sin θ_B, ω_B, e in the bearing frame) of clearance joint k."""
     bearing = system.clearance_bodies[k, 0]
     angle = body_pose(q, bearing)[2]
     wb = body_rates(qd, bearing)[2]
     c, s = np.cos(angle), np.sin(angle)
-    local_x, local_y = c * ex + s * ey, -s * ex + c * ey
-    rx, ry, tangent_x, tangent_y, curvature = nearest_point_kept(system, k, local_x, local_y)
+    return c, s, wb, c * ex + s * ey, -s * ex + c * ey
+
+
+@njit(cache=True, inline="always")
+def rim_contact(system, k, qd, c, s, wb, local_x, local_y, dex, dey, rx, ry):
+    """(δ, δ̇, n_x, n_y, v_t, r_x, r_y global, n in the bearing frame, |r − e|) of joint k's journal touching its worn
+    bore at r = (rx, ry) of the bearing frame (bearing_view's c, s, ω_B and local e): δ = R_J − |r − e|,
+    n = (r − e)/|r − e|, δ̇ = n·(ė − ω_B k×r), v_t = t·(ė − ω_B k×r) + ω_J R_J."""
+    p = system.clearance_params[k]
     gap_x, gap_y = rx - local_x, ry - local_y
     distance = np.sqrt(gap_x * gap_x + gap_y * gap_y)
     local_nx, local_ny = gap_x / distance, gap_y / distance
@@ -93,33 +132,41 @@ def worn_contact(system, k, q, qd, ex, ey, dex, dey):
     rate = nx * relative_x + ny * relative_y
     wj = body_rates(qd, system.clearance_bodies[k, 1])[2]
     sliding = -ny * relative_x + nx * relative_y + wj * p[CL_JOURNAL_RADIUS]
-    frame_x, frame_y = dex + wb * ey, dey - wb * ex  # ė − ω_B k×e, turned into the bearing frame below
-    local_rate_x, local_rate_y = c * frame_x + s * frame_y, -s * frame_x + c * frame_y
-    foot_rate = 0.0  # θ̇* of the closest point (none where it is not a minimum: free flight near the centre)
-    if curvature > 0.0:
-        foot_rate = (tangent_x * local_rate_x + tangent_y * local_rate_y) / curvature
-    normal_turn = wb + ((-local_ny * tangent_x + local_nx * tangent_y) * foot_rate
-                        - (-local_ny * local_rate_x + local_nx * local_rate_y)) / distance
-    return p[CL_JOURNAL_RADIUS] - distance, rate, nx, ny, sliding, arm_x, arm_y, normal_turn
+    return p[CL_JOURNAL_RADIUS] - distance, rate, nx, ny, sliding, arm_x, arm_y, local_nx, local_ny, distance
 
 
 @njit(cache=True, inline="always")
-def nearest_point_kept(system, k, local_x, local_y):
-    """(r_x, r_y, t_x, t_y, ρ'') of joint k's worn bore nearest to the journal centre (local_x, local_y) in the bearing
-    frame (wear.nearest_bore_point, by address), kept in system.bore_memo and found again only when that centre
-    changes bit for bit (and at a zero coordinate, whose sign the angle of e reads): the forces, the wear rates and
-    the stick row of one state share one search. The bore's profile is fixed for the arrays' life."""
+def kept_bore_points(system, k, local_x, local_y):
+    """system.bore_memo[k] for the journal centre (local_x, local_y) in the bearing frame: the centre, then
+    wear.nearest_bore_point's twelve values (the nearest point and the second rim, by address), found again only
+    when that centre changes bit for bit (and at a zero coordinate, whose sign the angle of e reads): the forces, the
+    wear rates and the stick row of one state share one search. The bore's profile is fixed for the arrays' life."""
     memo = system.bore_memo[k]
     if memo[0] != local_x or memo[1] != local_y or local_x == 0.0 or local_y == 0.0:
         p = system.clearance_params[k]
         found = system.bore_point(  # wear.nearest_bore_point, by address
             system.wear_profile[k], system.wear_harmonics[k], system.wear_depth_range[k],
             system.wear_bounds[k, WEAR_REACH], system.wear_bounds[k, WEAR_INNERMOST], p[CL_BEARING_RADIUS], local_x,
-            local_y)
+            local_y, p[CL_JOURNAL_RADIUS] + p[CL_DRY_GAP])
         memo[0], memo[1] = local_x, local_y
-        for i in range(6):
+        for i in range(12):
             memo[2 + i] = found[i]
+    return memo
+
+
+@njit(cache=True, inline="always")
+def nearest_point_kept(system, k, local_x, local_y):
+    """(r_x, r_y, t_x, t_y, ρ'') of joint k's worn bore nearest to the journal centre (local_x, local_y) in the bearing
+    frame (kept_bore_points)."""
+    memo = kept_bore_points(system, k, local_x, local_y)
     return memo[3], memo[4], memo[5], memo[6], memo[7]
+
+
+@njit(cache=True, inline="always")
+def second_point_kept(system, k, local_x, local_y):
+    """(θ, r_x, r_y) of the second rim joint k's journal at (local_x, local_y) touches (θ NaN: none; kept_bore_points)."""
+    memo = kept_bore_points(system, k, local_x, local_y)
+    return memo[8], memo[9], memo[10]
 
 
 @njit(cache=True)
@@ -180,9 +227,7 @@ def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact
     if mode == FREE or penetration <= 0.0:
         return 0.0, 0.0, 0.0
     p = system.clearance_params[k]
-    guarded_speed = max(impact_speed, p[CL_MIN_IMPACT_SPEED])  # grazing guard, docs/model.md
-    elastic = law_force(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT], p[CL_CLEARANCE])
-    force = damped_force(system.clearance_laws[k, 0], elastic, rate, guarded_speed, p[CL_RESTITUTION])
+    force, elastic = normal_force_magnitude(system, k, penetration, rate, impact_speed)
     law = system.clearance_laws[k, 1]
     if not exact_stick(system, k):
         mu = friction_coefficient(law, sliding, p[CL_MU_S], p[CL_MU_D], p[CL_V_LOW], p[CL_V_HIGH])
@@ -192,6 +237,43 @@ def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact
         direction = -1.0 if mode == SLIDE_BACK else 1.0
         mu = direction * sliding_coefficient(law, abs(sliding), p[CL_MU_S], p[CL_MU_D], p[CL_V_LOW], p[CL_V_HIGH])
     return force, -mu * force, elastic
+
+
+@njit(cache=True, inline="always")
+def normal_force_magnitude(system, k, penetration, rate, impact_speed):
+    """(F_n, F_el(δ)) of clearance joint k at δ > 0: its elastic law and damping (Meng 2015 eqs. 8–10)."""
+    p = system.clearance_params[k]
+    guarded_speed = max(impact_speed, p[CL_MIN_IMPACT_SPEED])  # grazing guard, docs/model.md
+    elastic = law_force(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT], p[CL_CLEARANCE])
+    return damped_force(system.clearance_laws[k, 0], elastic, rate, guarded_speed, p[CL_RESTITUTION]), elastic
+
+
+@njit(cache=True)
+def second_rim_force_magnitudes(system, k, penetration, rate, sliding, impact_speed):
+    """(F_n, F_t, F_el(δ)) at the second rim of a two-point contact (second_rim): the joint's elastic law and damping
+    (the impact speed of its contact episode), friction by its law as written, μ(v_t) of the rim's own sliding speed
+    (the exact stick of a sticking law is the nearer rim's); zero where the rim is not touched."""
+    if penetration <= 0.0:
+        return 0.0, 0.0, 0.0
+    p = system.clearance_params[k]
+    force, elastic = normal_force_magnitude(system, k, penetration, rate, impact_speed)
+    mu = friction_coefficient(system.clearance_laws[k, 1], sliding, p[CL_MU_S], p[CL_MU_D], p[CL_V_LOW], p[CL_V_HIGH])
+    return force, -mu * force, elastic
+
+
+@njit(cache=True, inline="always")
+def add_contact_pair(system, k, q, generalized, ex, ey, nx, ny, fn, ft, arm_x, arm_y):
+    """The force pair of a contact of joint k: −F_n n − F_t t on the journal at P_J + R_J n, the opposite on the
+    bearing at P_B + r (arm_x, arm_y: r, global)."""
+    p = system.clearance_params[k]
+    fx = -fn * nx - ft * ny
+    fy = -fn * ny + ft * nx
+    bearing = system.clearance_bodies[k, 0]
+    journal = system.clearance_bodies[k, 1]
+    bx, by = frame_point(kept_frame(system, q, bearing), p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
+    add_global_force(generalized, q, journal, bx + ex + p[CL_JOURNAL_RADIUS] * nx,
+                     by + ey + p[CL_JOURNAL_RADIUS] * ny, fx, fy)
+    add_global_force(generalized, q, bearing, bx + arm_x, by + arm_y, -fx, -fy)
 
 
 @njit(cache=True)
@@ -210,19 +292,17 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized, with_
             continue
         fn, ft, elastic = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], impact_speeds[k])
         contact_loss += (fn - elastic) * rate  # also while the damping term clips F_n to 0 with δ > 0
-        if fn == 0.0:
-            continue
-        p = system.clearance_params[k]
-        fx = -fn * nx - ft * ny
-        fy = -fn * ny + ft * nx
-        bearing = system.clearance_bodies[k, 0]
-        journal = system.clearance_bodies[k, 1]
-        bx, by = frame_point(kept_frame(system, q, bearing), p[CL_BEARING_POINT], p[CL_BEARING_POINT + 1])
-        add_global_force(generalized, q, journal, bx + ex + p[CL_JOURNAL_RADIUS] * nx,
-                         by + ey + p[CL_JOURNAL_RADIUS] * ny, fx, fy)
-        arm_x, arm_y = bearing_contact_arm(system, k, kinematics)
-        add_global_force(generalized, q, bearing, bx + arm_x, by + arm_y, -fx, -fy)
-        friction_loss -= ft * sliding
+        if fn != 0.0:
+            arm_x, arm_y = bearing_contact_arm(system, k, kinematics)
+            add_contact_pair(system, k, q, generalized, ex, ey, nx, ny, fn, ft, arm_x, arm_y)
+            friction_loss -= ft * sliding
+        if modes[k] != FREE and system.wear_harmonics[k] > 0:  # a second rim of a pocket tighter than the journal
+            penetration, rate, nx, ny, sliding, arm_x, arm_y = second_rim(system, k, q, qd, ex, ey, dex, dey)
+            fn, ft, elastic = second_rim_force_magnitudes(system, k, penetration, rate, sliding, impact_speeds[k])
+            contact_loss += (fn - elastic) * rate
+            if fn != 0.0:
+                add_contact_pair(system, k, q, generalized, ex, ey, nx, ny, fn, ft, arm_x, arm_y)
+                friction_loss -= ft * sliding
     return contact_loss, friction_loss
 
 
@@ -239,18 +319,29 @@ def add_wear_rates(system, q, qd, modes, impact_speeds, zdot):
         rates = zdot[slot:slot + 2 * harmonics + 1]
         for i in range(rates.shape[0]):
             rates[i] = 0.0
-        if modes[k] == STICK or modes[k] == FREE:
+        if modes[k] == FREE or (modes[k] == STICK and system.wear_harmonics[k] <= 0):
             continue
         kinematics = clearance_kinematics(system, k, q, qd)
-        _, _, _, _, penetration, rate, _, _, sliding = kinematics
-        fn = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], impact_speeds[k])[0]
-        if fn == 0.0:
-            continue
-        arm_x, arm_y = bearing_contact_arm(system, k, kinematics)
-        contact_angle = np.arctan2(arm_y, arm_x) - body_pose(q, system.clearance_bodies[k, 0])[2]
-        add_band_rates(rates, system.wear_rates[k, WEAR_WEIGHTS:], harmonics,
-                       system.wear_rates[k, WEAR_SCALE] * fn * abs(sliding), contact_angle,
-                       contact_half_angle(system, k, fn, contact_angle))
+        ex, ey, dex, dey, penetration, rate, _, _, sliding = kinematics
+        if modes[k] != STICK:
+            fn = contact_force_magnitudes(system, k, penetration, rate, sliding, modes[k], impact_speeds[k])[0]
+            if fn != 0.0:
+                arm_x, arm_y = bearing_contact_arm(system, k, kinematics)
+                add_contact_wear(system, k, q, rates, harmonics, fn, sliding, arm_x, arm_y)
+        if system.wear_harmonics[k] > 0:  # the second rim of a pocket tighter than the journal wears as well
+            penetration, rate, _, _, sliding, arm_x, arm_y = second_rim(system, k, q, qd, ex, ey, dex, dey)
+            fn = second_rim_force_magnitudes(system, k, penetration, rate, sliding, impact_speeds[k])[0]
+            if fn != 0.0:
+                add_contact_wear(system, k, q, rates, harmonics, fn, sliding, arm_x, arm_y)
+
+
+@njit(cache=True, inline="always")
+def add_contact_wear(system, k, q, rates, harmonics, fn, sliding, arm_x, arm_y):
+    """rates += the Archard profile rate of one contact of joint k: F_n, v_t, the bearing's contact point r (global)."""
+    contact_angle = np.arctan2(arm_y, arm_x) - body_pose(q, system.clearance_bodies[k, 0])[2]
+    add_band_rates(rates, system.wear_rates[k, WEAR_WEIGHTS:], harmonics,
+                   system.wear_rates[k, WEAR_SCALE] * fn * abs(sliding), contact_angle,
+                   contact_half_angle(system, k, fn, contact_angle))
 
 
 @njit(cache=True)
@@ -403,8 +494,13 @@ def potential_energy(system, q):
         angle = relative_angle(system, k, q)
         energy += 0.5 * p[0] * (angle - p[2]) ** 2 + p[3] * angle
     for k in range(system.clearance_bodies.shape[0]):
-        penetration = clearance_kinematics(system, k, q, zero)[4]
+        ex, ey, _, _, penetration = clearance_kinematics(system, k, q, zero)[:5]
         p = system.clearance_params[k]
         energy += law_state(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT],
                             p[CL_CLEARANCE])[2]
+        if system.wear_harmonics[k] > 0:  # and the second rim's of a two-point contact
+            rim = second_rim(system, k, q, zero, ex, ey, 0.0, 0.0)[0]
+            if rim > 0.0:
+                energy += law_state(system.clearance_laws[k, 3], rim, p[CL_STIFFNESS], p[CL_EXPONENT],
+                                    p[CL_CLEARANCE])[2]
     return energy + driveline_potential(system, q)

@@ -84,15 +84,19 @@ def _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, theta):
 
 
 @njit(cache=True)
-def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing_radius, ex, ey):
-    """closest_bore_point, searching only where the nearest point is not certain. A point inside the bore nearer to it
-    than its inner reach (inner_reach) lies on the inward normal of exactly one bore point, which is its nearest, so
-    the minimum of the distance Newton's method finds from the angle of e (descended_foot) is the nearest point when
-    its distance d is below the reach — always in contact (d ≈ R_J) on a bore nowhere tighter than the journal.
-    Otherwise (e far from the wall, or a bore worn tighter than the journal somewhere, whose distance has several local
-    minima: a two-point contact) a nearer point can only lie where ρ_min − |e| cos φ < d (φ = θ − θ_e; |r(θ) − e| ≥
-    ρ(θ) − |e| cos φ, ρ_min ≤ ρ = `innermost`), which narrows search_window's window; that is searched as
-    closest_bore_point does (searched_foot), and the nearer of its point and Newton's kept."""
+def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing_radius, ex, ey, within):
+    """closest_bore_point, searching only where the nearest point is not certain, and the second rim of a two-point
+    contact. A point inside the bore nearer to it than its inner reach (inner_reach) lies on the inward normal of
+    exactly one bore point, which is its nearest, so the minimum of the distance Newton's method finds from the angle
+    of e (descended_foot) is the nearest point when its distance d is below the reach — always in contact (d ≈ R_J)
+    on a bore nowhere tighter than the journal. Otherwise (e far from the wall, or a bore worn tighter than the
+    journal somewhere, whose distance has several local minima: a two-point contact) a nearer point can only lie where
+    ρ_min − |e| cos φ < d (φ = θ − θ_e; |r(θ) − e| ≥ ρ(θ) − |e| cos φ, ρ_min ≤ ρ = `innermost`), which narrows
+    search_window's window; that is searched as closest_bore_point does (searched_foot), and the nearer of its point
+    and Newton's kept. Where the reach is below `within` (the journal's radius: the bore may be tighter than the
+    journal) and that point is nearer than `within`, the nearest other minimum nearer than `within` is the second
+    rim the journal touches (second_foot; θ NaN where there is none). Returns (θ*, r_x, r_y, t_x, t_y, g') of the
+    nearest point, then the same of the second rim."""
     eccentricity = math.sqrt(ex * ex + ey * ey)
     start = math.atan2(ey, ex) if eccentricity > 0.0 else 0.0
     spacing = 2.0 * math.pi / (8.0 * max(harmonics, 1))
@@ -107,21 +111,62 @@ def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, b
         if not distance <= math.sqrt(_distance_squared(coefficients, harmonics, bearing_radius, ex, ey, searched)):
             theta = searched
     rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
-    return theta, rx, ry, tx, ty, second
-
-
-# nearest_bore_point's type as the kernels call it by address (KernelArrays.bore_point, assembly/arrays.py): a row
-# of wear_profile, the harmonics, depth range, reach, innermost radius, R_B, e_x, e_y -> (θ*, r_x, r_y, t_x, t_y, ρ'')
-BORE_POINT_TYPE = types.FunctionType(types.UniTuple(types.float64, 6)(
-    types.float64[::1], types.int64, types.float64, types.float64, types.float64, types.float64, types.float64,
-    types.float64))
+    rim = math.nan
+    if reach < within and (rx - ex) ** 2 + (ry - ey) ** 2 < within * within:
+        rim = second_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing,
+                          nearer_window(eccentricity, innermost, within), theta, within)
+    rim_x, rim_y, rim_tx, rim_ty, rim_second = 0.0, 0.0, 0.0, 0.0, 0.0
+    if rim == rim:
+        rim_x, rim_y, rim_tx, rim_ty, _, rim_second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, rim)
+    return theta, rx, ry, tx, ty, second, rim, rim_x, rim_y, rim_tx, rim_ty, rim_second
 
 
 @njit(cache=True)
-def no_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing_radius, ex, ey):
+def second_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing, window, first, within):
+    """θ of the nearest local minimum of |r(θ) − e| other than the one at `first` and nearer than `within`: the
+    second rim of a journal in a bore worn tighter than itself (NaN where there is none). The bore is sampled every
+    half `spacing` over `window` round `start` (one sample more either side); each sampled local minimum is refined
+    (refined_foot) and kept if it converges to a minimum other than `first` (more than half a sample apart) with e on
+    the bore's inward side. Two rims within half a sample of each other are one contact (the nearer)."""
+    spacing = 0.5 * spacing
+    samples = int(math.ceil(window / spacing)) + 1
+    best, best_distance = math.nan, within
+    before = _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, start - (samples + 1) * spacing)
+    here = _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, start - samples * spacing)
+    for i in range(-samples, samples + 1):
+        after = _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, start + (i + 1) * spacing)
+        candidate = start + i * spacing
+        if here <= before and here < after:
+            theta, converged = refined_foot(coefficients, harmonics, bearing_radius, ex, ey, candidate, spacing)
+            if converged and abs(_wrapped(theta - first)) > 0.5 * spacing:
+                rx, ry, tx, ty, _, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
+                dx, dy = ex - rx, ey - ry
+                distance = math.sqrt(dx * dx + dy * dy)
+                if second > 0.0 and dy * tx - dx * ty > 0.0 and distance < best_distance:
+                    best, best_distance = theta, distance
+        before, here = here, after
+    return best
+
+
+@njit(cache=True, inline="always")
+def _wrapped(angle):
+    """angle in [−π, π)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+# nearest_bore_point's type as the kernels call it by address (KernelArrays.bore_point, assembly/arrays.py): a row
+# of wear_profile, the harmonics, depth range, reach, innermost radius, R_B, e_x, e_y, the second rim's reach ->
+# (θ*, r_x, r_y, t_x, t_y, g'') of the nearest point and of the second rim (θ NaN: none)
+BORE_POINT_TYPE = types.FunctionType(types.UniTuple(types.float64, 12)(
+    types.float64[::1], types.int64, types.float64, types.float64, types.float64, types.float64, types.float64,
+    types.float64, types.float64))
+
+
+@njit(cache=True)
+def no_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing_radius, ex, ey, within):
     """nearest_bore_point's stand-in for a model without worn bores, of the same type and never called (its kernels
     reach the worn-bore geometry only for a joint with harmonics > 0): such a model does not compile that geometry."""
-    return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
 
 
 def bore_point_kernel(harmonics: np.ndarray):

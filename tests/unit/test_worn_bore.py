@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 
 from clearsim.assembly.arrays import for_kernels
-from clearsim.assembly.forces import clearance_kinematics, stick_row
+from clearsim.assembly.forces import clearance_kinematics, second_rim, stick_row
 from clearsim.assembly.system import assemble
 from clearsim.model.loader import load_mechanism_text
 from clearsim.physics import wear
-from tests.support.worn_bore import nearest_bore_contact
+from tests.support.worn_bore import bore_contacts, nearest_bore_contact, series_profile
 
 BEARING_RADIUS = 0.02
 CLEARANCE = 1e-4
@@ -205,23 +205,38 @@ def test_a_pocket_tighter_than_the_journal_touches_it_at_its_rims():
     wear.add_kernel_rates(rates, wear.kernel_weights(sigma, harmonics), harmonics, 1.0, 0.0)
     coefficients = rates * 1e-5 / wear.evaluate_profile(rates, np.array([0.0]))[0]  # 10 µm deep at θ = 0
 
-    def profile(theta):
-        theta = np.asarray(theta, float)
-        orders = np.arange(1, harmonics + 1)
-        phases = np.multiply.outer(theta, orders)
-        a, b = coefficients[1::2], coefficients[2::2]
-        return (coefficients[0] + np.cos(phases) @ a + np.sin(phases) @ b,
-                (-np.sin(phases) * orders) @ a + (np.cos(phases) * orders) @ b,
-                (-np.cos(phases) * orders ** 2) @ a + (-np.sin(phases) * orders ** 2) @ b)
-
+    profile = series_profile(coefficients)
     depth_range = wear.depth_range(coefficients)
-    for angle in np.radians([-3.0, -1.0, 0.0, 0.4, 2.0, 5.0]):
-        for eccentricity in (0.49e-3, 0.505e-3):
+    reach, innermost = wear.inner_reach(coefficients, bearing), wear.innermost_radius(coefficients, bearing)
+    two_point = 0
+    for angle in np.radians([-3.0, -1.0, -0.2, 0.0, 0.1, 0.4, 2.0, 5.0]):
+        for eccentricity in (0.49e-3, 0.505e-3, 0.506e-3):
             e = eccentricity * np.array([np.cos(angle), np.sin(angle)])
             theta, rx, ry, *_ = wear.closest_bore_point(coefficients, harmonics, depth_range, bearing, e[0], e[1])
             penetration = journal - np.hypot(rx - e[0], ry - e[1])
             expected, _ = nearest_bore_contact(profile, bearing, journal, e)
             assert penetration == pytest.approx(expected, abs=1e-12), (np.degrees(angle), eccentricity)
+            # the second rim (nearest_bore_point's last six values): the reference's other touched point, or none
+            found = wear.nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing, *e,
+                                            journal)
+            touched = bore_contacts(profile, bearing, journal, e)
+            assert journal - np.hypot(found[1] - e[0], found[2] - e[1]) == pytest.approx(expected, abs=1e-12)
+            if len(touched) < 2:
+                assert np.isnan(found[6]), (np.degrees(angle), eccentricity)
+                continue
+            two_point += 1
+            rim = journal - np.hypot(found[7] - e[0], found[8] - e[1])
+            assert rim == pytest.approx(touched[1][0], abs=1e-12)
+            angles = sorted((value + np.pi) % (2 * np.pi) - np.pi for value in (found[0], found[6]))
+            assert angles == pytest.approx(sorted((t + np.pi) % (2 * np.pi) - np.pi for _, _, t in touched), abs=1e-9)
+    assert two_point >= 4  # the journal pressed into the pocket near its axis touches both rims
+
+
+def test_a_bore_nowhere_tighter_than_the_journal_has_no_second_rim(system):
+    """The oval of the module's model: every journal position near the wall touches it at one point only."""
+    for q, qd, _ in journal_states():
+        ex, ey, dex, dey = clearance_kinematics(system, 0, q, qd)[:4]
+        assert second_rim(system, 0, q, qd, ex, ey, dex, dey)[0] == -np.inf
 
 
 def random_profiles(seed, count):
@@ -251,7 +266,7 @@ def test_newton_alone_finds_the_searched_nearest_point():
         for _ in range(50):
             angle = rng.uniform(-np.pi, np.pi)
             e = rng.uniform(0.0, 2 * clearance + depth_range) * np.array([np.cos(angle), np.sin(angle)])
-            nearest = wear.nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing, *e)
+            nearest = wear.nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing, *e, 0.0)
             searched = wear.closest_bore_point(coefficients, harmonics, depth_range, bearing, *e)
             distance = np.hypot(nearest[1] - e[0], nearest[2] - e[1])
             searched_distance = np.hypot(searched[1] - e[0], searched[2] - e[1])

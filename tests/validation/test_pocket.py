@@ -1,0 +1,100 @@
+"""A journal in a worn pocket tighter than itself touches both rims (docs/model-contact.md, "A pocket tighter than the
+journal"): energy is conserved through its bounces with the elastic energy of both rims, the written dissipation
+closes the balance with damping and friction at both, and at rest it bridges the pocket on its two rims, each
+carrying m g / (2 cos β) (β: the angle of a rim's normal from the vertical, from an independent reference geometry).
+
+The pocket: 10 µm deep, worn by a kernel 1.5 mm wide at the bottom of a 10 mm bore, its tightest radius of curvature
+7.97 mm against the journal's 9.5 mm; a journal resting in it touches the rims 6.35° either side of the bottom."""
+
+import numpy as np
+import pytest
+
+from clearsim.physics import wear
+from tests.support.worn_bore import bore_contacts, series_profile
+
+BEARING, JOURNAL, HARMONICS = 0.010, 0.0095, 64
+MASS, GRAVITY = 1.0, 9.81
+BOTTOM = -0.5 * np.pi
+
+
+def pocket_coefficients(depth=1e-5, width=0.0015):
+    """[a_0, a_1, b_1, …] of a pocket `depth` deep at the bore's bottom, worn by a kernel `width` wide."""
+    rates = np.zeros(2 * HARMONICS + 1)
+    weights = wear.kernel_weights(wear.kernel_sigma(width, HARMONICS, BEARING), HARMONICS)
+    wear.add_kernel_rates(rates, weights, HARMONICS, 1.0, BOTTOM)
+    return rates * depth / wear.evaluate_profile(rates, np.array([BOTTOM]))[0]
+
+
+def model(contact, friction="{law: none}", t_end="20 ms"):
+    coefficients = pocket_coefficients()
+    cosines = ", ".join(repr(float(value)) for value in [coefficients[0], *coefficients[1::2]])
+    sines = ", ".join(repr(float(value)) for value in coefficients[2::2])
+    return f"""
+name: a journal dropped into a pocket tighter than itself
+units: SI
+gravity: [0, {-GRAVITY}]
+defaults:
+  contact: {contact}
+  friction: {friction}
+points: {{O: [0, 0]}}
+bodies:
+  - {{name: pin, mass: {MASS}, inertia: 1e-4, position: [0, 0]}}
+joints:
+  - {{name: J, type: revolute, bodies: [ground, pin], at: O, bearing_radius: {BEARING}, clearance: {BEARING - JOURNAL},
+      wear: {{profile: {{cos: [{cosines}], sin: [{sines}]}}}}}}
+solver: {{t_end: {t_end}, output_rate: 10 kHz, rtol: 1e-9, atol: 1e-12, max_step: 0.1 ms}}
+"""
+
+
+ELASTIC = "{law: hertz, restitution: 1.0, exponent: 1.5, stiffness: auto}"
+DAMPED = "{law: lankarani_nikravesh, restitution: 0.5, exponent: 1.5, stiffness: auto}"
+
+
+def rims(centre):
+    """(penetration, unit normal from the journal's centre) of each bore point the journal centred at `centre` touches,
+    from the independent reference geometry (a dense polygon refined by Newton's method on the explicit series)."""
+    return [contact[:2] for contact in bore_contacts(series_profile(pocket_coefficients()), BEARING, JOURNAL, centre)]
+
+
+def test_the_pocket_is_tighter_than_the_journal():
+    assert wear.tightest_radius(pocket_coefficients(), BEARING) < 0.85 * JOURNAL
+
+
+def test_a_journal_bouncing_in_a_pocket_conserves_energy_with_both_rims(simulate):
+    """Dropped onto the pocket's axis, the journal lands on both rims at once and bounces straight back: the rims'
+    forces cancel sideways (a contact at the nearer rim alone would push it off the axis), and kinetic energy, gravity
+    and both rims' elastic energy add up to their start to 1e-6 of the kinetic energy."""
+    result = simulate(model(ELASTIC))
+    energy = result["energy/kinetic"] + result["energy/potential"]
+    scale = np.max(result["energy/kinetic"])
+    assert scale > 0.9 * MASS * GRAVITY * (BEARING - JOURNAL)  # it fell the clearance onto the rims
+    assert np.max(result["joints/J/normal_force"]) > 100.0  # and bounced off them
+    assert np.max(np.abs(energy - energy[0])) <= 1e-6 * scale
+    assert np.max(np.abs(result["joints/J/eccentricity"][:, 0])) < 1e-12  # straight down and up the axis
+
+
+@pytest.mark.parametrize("friction", ["{law: none}", "{law: ambrosio, mu_d: 0.15, v_0: 1e-4 m/s, v_1: 1e-2 m/s}"])
+def test_the_written_dissipation_closes_the_balance_in_a_pocket(simulate, friction):
+    """Damped, and with friction at both rims, started off the axis so that the journal rocks from rim to rim. (A
+    law with a sticking phase sticks at the nearer rim only: the journal coming to rest in the pocket then chatters
+    between the rims, docs/model-contact.md.)"""
+    text = model(DAMPED, friction, t_end="60 ms").replace("position: [0, 0]", "position: [2e-4, 0]")
+    result = simulate(text)
+    lost = result["energy/contact_dissipated"][-1] + result["energy/friction_dissipated"][-1]
+    assert lost > 0.5 * np.max(result["energy/kinetic"])  # most of the fall's energy is gone
+    assert np.max(np.abs(result["energy/balance_error"])) <= 1e-3 * lost
+
+
+def test_a_journal_at_rest_in_a_pocket_bridges_its_two_rims(simulate):
+    """After its bounces die out the journal rests on the axis touching both rims equally, each pressing it with
+    m g / (2 cos β) against gravity."""
+    result = simulate(model(DAMPED, t_end="200 ms"))
+    centre = result["joints/J/eccentricity"][-1]
+    touched = rims(centre)
+    assert len(touched) == 2
+    (first, normal), (second, _) = touched
+    assert second == pytest.approx(first, rel=1e-6)  # equally deep at both rims
+    assert abs(centre[0]) < 1e-12
+    expected = MASS * GRAVITY / (2.0 * -normal[1])
+    assert result["joints/J/normal_force"][-1] == pytest.approx(expected, rel=1e-5)
+    assert result["joints/J/penetration"][-1] == pytest.approx(first, rel=1e-5)

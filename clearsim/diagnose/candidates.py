@@ -303,7 +303,7 @@ def arc_sigma(depth: float, radius: float, clearance: float, present: np.ndarray
     """σ (rad) of a worn arc's kernel at φ: that of the width R_B · WEAR_ARC, or the narrowest whose sum with the
     bore's `present` wear has its tightest radius of curvature at R_B − (1 − WEAR_POCKET_CLEARANCE) c, when the 60°
     arc makes it tighter than that. A journal cannot wear a pocket tighter than itself, and one tighter than the
-    journal touches it at two points, between which the one-point contact's normal flips (a 0.0105 mm arc in a
+    journal touches it at two points, where a journal sticking at the nearer chatters (a 0.0105 mm arc in a
     0.01 mm joint of R_B = 50 mm: radius 49.950 mm against the journal's 49.990 mm; 49.991 mm as widened). A present
     wear too tight for any arc to leave the journal that (`validate` warns of it) leaves the arc at its width."""
     narrow = kernel_sigma(WEAR_ARC * radius, WEAR_HARMONICS, radius)

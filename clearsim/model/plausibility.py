@@ -86,7 +86,8 @@ def _clearance_joint_warnings(mechanism, sizes: dict[str, float]) -> list[Proble
 
 def _worn_pocket(joint, parameters, path: tuple) -> list[Problem]:
     """A worn profile with a pocket tighter than the journal (its smallest radius of curvature below R_J): the journal
-    touches it at two points, between which the one-point contact's normal flips, and the run crawls."""
+    touches it at two points, and where it comes to rest there a friction law with exact sticking (which sticks at the
+    nearer rim only) makes the run crawl."""
     profile = joint.wear.profile if joint.wear is not None else None
     if profile is None:
         return []
@@ -97,7 +98,8 @@ def _worn_pocket(joint, parameters, path: tuple) -> list[Problem]:
         return []
     return [Problem(path + ("wear", "profile"), f"the worn bore of joint '{joint.name}' has a pocket tighter than its "
                     f"journal ({pocket_words(tightest, parameters.journal_radius)}): the journal touches it at two "
-                    "points and the contact flips between them, which makes the run take tiny steps",
+                    "points, and a friction law with exact sticking sticks at the nearer only, which makes the run "
+                    "crawl where the journal comes to rest in the pocket",
                     "check the profile's units and harmonics: a journal wears a pocket at least as wide as itself "
                     "(fewer or smaller high harmonics widen it)")]
 

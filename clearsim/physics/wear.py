@@ -125,10 +125,9 @@ def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, b
 def second_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing, window, first, within):
     """θ of the nearest local minimum of |r(θ) − e| other than the one at `first` and nearer than `within`: the
     second rim of a journal in a bore worn tighter than itself (NaN where there is none). The bore is sampled every
-    half `spacing` over `window` round `start` (one sample more either side); each sampled local minimum is refined
-    (refined_foot) and kept if it converges to a minimum other than `first` (more than half a sample apart) with e on
-    the bore's inward side. Two rims within half a sample of each other are one contact (the nearer)."""
-    spacing = 0.5 * spacing
+    `spacing` over `window` round `start` (one sample more either side); each sampled local minimum more than 1.5
+    spacings from `first` is refined (refined_foot) and kept if it converges, more than half a spacing from `first`, to
+    a minimum with e on the bore's inward side. Rims closer than that are one contact (the nearer)."""
     samples = int(math.ceil(window / spacing)) + 1
     best, best_distance = math.nan, within
     before = _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, start - (samples + 1) * spacing)
@@ -136,7 +135,7 @@ def second_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing,
     for i in range(-samples, samples + 1):
         after = _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, start + (i + 1) * spacing)
         candidate = start + i * spacing
-        if here <= before and here < after:
+        if here <= before and here < after and abs(_wrapped(candidate - first)) > 1.5 * spacing:
             theta, converged = refined_foot(coefficients, harmonics, bearing_radius, ex, ey, candidate, spacing)
             if converged and abs(_wrapped(theta - first)) > 0.5 * spacing:
                 rx, ry, tx, ty, _, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
@@ -386,8 +385,8 @@ def tightest_radius(coefficients, bearing_radius: float) -> float:
 
 def pocket_radius(coefficients, bearing_radius: float, journal_radius: float) -> float | None:
     """The bore's tightest radius of curvature (m) where it is tighter than the journal, a pocket the journal touches
-    at its two rims (the one-point contact takes the nearer, and its normal flips as the journal crosses); None where
-    the bore is nowhere tighter than the journal (or circular)."""
+    at its two rims (nearest_bore_point's second rim); None where the bore is nowhere tighter than the journal (or
+    circular)."""
     if (len(coefficients) - 1) // 2 <= 0:
         return None
     tightest = tightest_radius(coefficients, bearing_radius)

@@ -182,9 +182,9 @@ def mechanism_extent(system: System) -> float:
 
 def worn_pockets(system: System) -> list[str]:
     """In words (a list of one, or none): the clearance joints whose worn bore has a pocket tighter than the journal.
-    A journal pressed into it touches its two rims, the one-point contact takes the nearer and its normal flips
-    between them as the journal crosses, and the steps follow every flip (docs/model-contact.md, "Contact on a worn
-    bore")."""
+    A journal pressed into it touches its two rims; a friction law with exact sticking sticks at the nearer only, so a
+    journal coming to rest there chatters between them (docs/model-contact.md, "A pocket tighter than the
+    journal")."""
     arrays = system.arrays
     pockets = []
     for k, name in enumerate(system.clearance_joints):
@@ -197,9 +197,9 @@ def worn_pockets(system: System) -> list[str]:
     if not pockets:
         return []
     return [f"a worn bore with a pocket tighter than its journal at {', '.join(pockets)}: the journal touches the "
-            "pocket's two rims and the contact's normal flips between them at every crossing, which the steps follow; "
-            "give `wear.profile` no pocket narrower than the journal (R_B + h + h'' >= R_J everywhere: fewer or "
-            "smaller high harmonics)"]
+            "pocket's two rims, and a friction law with exact sticking sticks at the nearer one only, so a journal "
+            "coming to rest there chatters between them; give `wear.profile` no pocket narrower than the journal "
+            "(R_B + h + h'' >= R_J everywhere: fewer or smaller high harmonics), or the friction `stick: smooth`"]
 
 
 def likely_causes(system: System, pace: Pace) -> list[str]:

@@ -72,3 +72,40 @@ def series_profile(coefficients):
                 (-np.cos(phases) * orders ** 2) @ a + (-np.sin(phases) * orders ** 2) @ b)
 
     return profile
+
+
+POCKET_BEARING, POCKET_JOURNAL, POCKET_HARMONICS = 0.010, 0.0095, 64
+
+
+def pocket_coefficients(depth=1e-5, width=0.0015, angle=-0.5 * np.pi):
+    """[a_0, a_1, b_1, …] of a pocket `depth` deep at `angle` (the bottom) of a 10 mm bore, worn by a kernel `width`
+    wide: 7.97 mm its tightest radius of curvature, against the 9.5 mm journal of pocket_model."""
+    from clearsim.physics import wear
+
+    rates = np.zeros(2 * POCKET_HARMONICS + 1)
+    weights = wear.kernel_weights(wear.kernel_sigma(width, POCKET_HARMONICS, POCKET_BEARING), POCKET_HARMONICS)
+    wear.add_kernel_rates(rates, weights, POCKET_HARMONICS, 1.0, angle)
+    return rates * depth / wear.evaluate_profile(rates, np.array([angle]))[0]
+
+
+def pocket_model(contact, friction="{law: none}", t_end="20 ms", start=0.0, mass=1.0, gravity=9.81):
+    """A journal (a pin of `mass`, its centre `start` m right of the bore's) dropped by gravity into the pocket at the
+    bottom of a fixed worn bore (pocket_coefficients), as YAML text in SI."""
+    coefficients = pocket_coefficients()
+    cosines = ", ".join(repr(float(value)) for value in [coefficients[0], *coefficients[1::2]])
+    sines = ", ".join(repr(float(value)) for value in coefficients[2::2])
+    return f"""
+name: a journal dropped into a pocket tighter than itself
+units: SI
+gravity: [0, {-gravity}]
+defaults:
+  contact: {contact}
+  friction: {friction}
+points: {{O: [0, 0]}}
+bodies:
+  - {{name: pin, mass: {mass}, inertia: 1e-4, position: [{start}, 0]}}
+joints:
+  - {{name: J, type: revolute, bodies: [ground, pin], at: O, bearing_radius: {POCKET_BEARING},
+      clearance: {POCKET_BEARING - POCKET_JOURNAL}, wear: {{profile: {{cos: [{cosines}], sin: [{sines}]}}}}}}
+solver: {{t_end: {t_end}, output_rate: 10 kHz, rtol: 1e-9, atol: 1e-12, max_step: 0.1 ms}}
+"""

@@ -14,6 +14,7 @@ from clearsim.model.loader import load_mechanism
 from clearsim.runner import prepare, simulate_config
 from clearsim.solver import integrator as ig
 from clearsim.solver import simulate as sim
+from tests.support.worn_bore import pocket_model
 
 CONFIGS = Path(__file__).resolve().parents[2] / "clearsim" / "configs"
 FRICTION = CONFIGS / "slider_crank_flores_friction.yaml"
@@ -143,23 +144,29 @@ def test_a_slow_run_warns_once_with_its_pace_and_finishes(monkeypatch):
 
 UHV = CONFIGS / "uhv_breaker.yaml"
 # an oval 20 µm deep at A and J (radius of curvature 49.9601 mm at its bottom, against the journal's 49.9900 mm): the
-# journal pressed into it touches both rims (at A at 0.785 ms: 48° either side of the bottom, 8.8 and 8.3 µm deep),
-# and the contact's normal flips between them at every crossing; from 2.9 ms on the steps collapse to 2.5 ns
+# journal pressed into it touches both rims (at A at 0.785 ms: 48° either side of the bottom, 8.8 and 8.3 µm deep)
 OVAL_POCKET = [f"joints.{joint}.wear.profile.cos=[0.02mm, 0, 0.02mm]" for joint in "AJ"]
 POCKET = "a worn bore with a pocket tighter than its journal at joint A (smallest radius of curvature 49.9601 mm"
+# a journal dropped into a pocket tighter than itself, damped, with exact sticking: coming to rest on the rims at
+# ~10 ms it sticks at the nearer one only and chatters between them until the steps reach min_step
+STICKING = "{law: stiction_step, mu_s: 0.2, mu_d: 0.15, v_s: 1e-4 m/s, v_d: 1e-2 m/s}"
+DAMPED = "{law: lankarani_nikravesh, restitution: 0.5, exponent: 1.5, stiffness: auto}"
 
 
-def test_a_run_collapsed_in_a_worn_pocket_names_the_pocket_first(tmp_path):
-    """The collapse's likely causes give the pocket, its radius against the journal's and the fix, before the
-    friction; the partial result is written and flagged."""
-    report = simulate_config(UHV, OVAL_POCKET, tmp_path / "r.h5")  # the 85 ms stroke: hopeless at 2.9 ms
+def test_a_run_stopped_in_a_worn_pocket_names_the_pocket_first(tmp_path):
+    """The stop's likely causes give the pocket, its radius against the journal's and the fixes, before the other
+    causes; the partial result is written and flagged."""
+    config = tmp_path / "pocket.yaml"
+    config.write_text(pocket_model(DAMPED, STICKING, t_end="60 ms", start=2e-4))
+    report = simulate_config(config, [], tmp_path / "r.h5")
     assert not report.complete and isinstance(report.error, SolverError), report.status
     text = str(report.error)
-    assert "collapsed" in text and report.error.time < 4e-3
-    assert text.index(POCKET) < text.index("friction")
-    assert "against the journal's 49.9900 mm" in text and "R_B + h + h'' >= R_J" in text
+    assert report.error.time < 20e-3
+    pocket = "a worn bore with a pocket tighter than its journal at joint J (smallest radius of curvature 7.9729 mm"
+    assert text.index(pocket) < text.index("Otherwise")
+    assert "against the journal's 9.5000 mm" in text and "R_B + h + h'' >= R_J" in text and "stick: smooth" in text
     with h5py.File(report.output, "r") as result:
-        assert not result.attrs["complete"] and POCKET in result.attrs["status"]
+        assert not result.attrs["complete"] and pocket in result.attrs["status"]
 
 
 def test_a_stop_at_min_step_in_a_worn_pocket_names_the_pocket_first():

@@ -10,40 +10,15 @@ import numpy as np
 import pytest
 
 from clearsim.physics import wear
-from tests.support.worn_bore import bore_contacts, series_profile
+from tests.support.worn_bore import (POCKET_BEARING, POCKET_JOURNAL, bore_contacts, pocket_coefficients,
+                                    pocket_model, series_profile)
 
-BEARING, JOURNAL, HARMONICS = 0.010, 0.0095, 64
+BEARING, JOURNAL = POCKET_BEARING, POCKET_JOURNAL
 MASS, GRAVITY = 1.0, 9.81
-BOTTOM = -0.5 * np.pi
 
 
-def pocket_coefficients(depth=1e-5, width=0.0015):
-    """[a_0, a_1, b_1, …] of a pocket `depth` deep at the bore's bottom, worn by a kernel `width` wide."""
-    rates = np.zeros(2 * HARMONICS + 1)
-    weights = wear.kernel_weights(wear.kernel_sigma(width, HARMONICS, BEARING), HARMONICS)
-    wear.add_kernel_rates(rates, weights, HARMONICS, 1.0, BOTTOM)
-    return rates * depth / wear.evaluate_profile(rates, np.array([BOTTOM]))[0]
-
-
-def model(contact, friction="{law: none}", t_end="20 ms"):
-    coefficients = pocket_coefficients()
-    cosines = ", ".join(repr(float(value)) for value in [coefficients[0], *coefficients[1::2]])
-    sines = ", ".join(repr(float(value)) for value in coefficients[2::2])
-    return f"""
-name: a journal dropped into a pocket tighter than itself
-units: SI
-gravity: [0, {-GRAVITY}]
-defaults:
-  contact: {contact}
-  friction: {friction}
-points: {{O: [0, 0]}}
-bodies:
-  - {{name: pin, mass: {MASS}, inertia: 1e-4, position: [0, 0]}}
-joints:
-  - {{name: J, type: revolute, bodies: [ground, pin], at: O, bearing_radius: {BEARING}, clearance: {BEARING - JOURNAL},
-      wear: {{profile: {{cos: [{cosines}], sin: [{sines}]}}}}}}
-solver: {{t_end: {t_end}, output_rate: 10 kHz, rtol: 1e-9, atol: 1e-12, max_step: 0.1 ms}}
-"""
+def model(contact, friction="{law: none}", t_end="20 ms", start=0.0):
+    return pocket_model(contact, friction, t_end, start, MASS, GRAVITY)
 
 
 ELASTIC = "{law: hertz, restitution: 1.0, exponent: 1.5, stiffness: auto}"
@@ -78,8 +53,7 @@ def test_the_written_dissipation_closes_the_balance_in_a_pocket(simulate, fricti
     """Damped, and with friction at both rims, started off the axis so that the journal rocks from rim to rim. (A
     law with a sticking phase sticks at the nearer rim only: the journal coming to rest in the pocket then chatters
     between the rims, docs/model-contact.md.)"""
-    text = model(DAMPED, friction, t_end="60 ms").replace("position: [0, 0]", "position: [2e-4, 0]")
-    result = simulate(text)
+    result = simulate(model(DAMPED, friction, t_end="60 ms", start=2e-4))
     lost = result["energy/contact_dissipated"][-1] + result["energy/friction_dissipated"][-1]
     assert lost > 0.5 * np.max(result["energy/kinetic"])  # most of the fall's energy is gone
     assert np.max(np.abs(result["energy/balance_error"])) <= 1e-3 * lost

@@ -32,6 +32,8 @@ NEWTON_TOLERANCE = 1e-12  # rad: the point after such a step is off by ~(g''/2g'
 # makes the steps jitter at ~ε R_B/|e| (5e-13 rad in a 0.01 mm joint of R_B = 50 mm): a smaller one is never reached
 WALK_SPACINGS = 4  # the longest step towards a minimum before its bracket, in sample spacings 2π/(8M)
 SMALLEST_SIGMA = 4.0  # σ ≥ 4/M: the truncated kernel's last weight is e^{-8} = 3e-4 of the first (no ringing)
+RIM_SPACING = math.pi / 64.0  # rad: the second rim's search samples at least this finely (a few harmonics' bore has
+# its rims tens of degrees apart, which the 2π/(8M) of its nearest-point search can step over)
 CONFORMAL_HALF_ANGLE = 0.5 * math.pi  # rad: a journal touches its bore within 90° of the load, however conformal
 
 
@@ -113,7 +115,7 @@ def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, b
     rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
     rim = math.nan
     if reach < within and (rx - ex) ** 2 + (ry - ey) ** 2 < within * within:
-        rim = second_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing,
+        rim = second_foot(coefficients, harmonics, bearing_radius, ex, ey, start, min(spacing, RIM_SPACING),
                           nearer_window(eccentricity, innermost, within), theta, within)
     rim_x, rim_y, rim_tx, rim_ty, rim_second = 0.0, 0.0, 0.0, 0.0, 0.0
     if rim == rim:

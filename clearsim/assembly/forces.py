@@ -96,7 +96,7 @@ def second_rim(system, k, q, qd, ex, ey, dex, dey):
     """(δ, δ̇, n_x, n_y, v_t, r_x, r_y) of the second rim joint k's journal touches in a worn bore tighter than
     itself (wear.second_foot), as worn_contact's of the nearest point (δ measured as the joint's: from its dry gap);
     δ = −inf where there is none (docs/model-contact.md, "A pocket tighter than the journal")."""
-    if system.wear_harmonics[k] <= 0:
+    if not may_touch_two_rims(system, k):
         return -np.inf, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0
     c, s, wb, local_x, local_y = bearing_view(system, k, q, qd, ex, ey)
     rim, rx, ry = second_point_kept(system, k, local_x, local_y)
@@ -105,6 +105,21 @@ def second_rim(system, k, q, qd, ex, ey, dex, dey):
     penetration, rate, nx, ny, sliding, arm_x, arm_y = rim_contact(system, k, qd, c, s, wb, local_x, local_y, dex, dey,
                                                                    rx, ry)[:7]
     return penetration + system.clearance_params[k, CL_DRY_GAP], rate, nx, ny, sliding, arm_x, arm_y
+
+
+@njit(cache=True, inline="always")
+def second_rim_reach(system, k):
+    """The distance from the journal's centre within which a bore point touches it: R_J (+ h_dry of a lubricated
+    joint)."""
+    p = system.clearance_params[k]
+    return p[CL_JOURNAL_RADIUS] + p[CL_DRY_GAP]
+
+
+@njit(cache=True, inline="always")
+def may_touch_two_rims(system, k):
+    """Joint k's worn bore has an inner reach below second_rim_reach, so that a journal may touch it at two rims
+    (wear.nearest_bore_point looks for a second one only then): fixed at assembly."""
+    return system.wear_harmonics[k] > 0 and system.wear_bounds[k, WEAR_REACH] < second_rim_reach(system, k)
 
 
 @njit(cache=True, inline="always")
@@ -147,7 +162,7 @@ def kept_bore_points(system, k, local_x, local_y):
         found = system.bore_point(  # wear.nearest_bore_point, by address
             system.wear_profile[k], system.wear_harmonics[k], system.wear_depth_range[k],
             system.wear_bounds[k, WEAR_REACH], system.wear_bounds[k, WEAR_INNERMOST], p[CL_BEARING_RADIUS], local_x,
-            local_y, p[CL_JOURNAL_RADIUS] + p[CL_DRY_GAP])
+            local_y, second_rim_reach(system, k))
         memo[0], memo[1] = local_x, local_y
         for i in range(12):
             memo[2 + i] = found[i]
@@ -296,7 +311,7 @@ def add_clearance_forces(system, q, qd, modes, impact_speeds, generalized, with_
             arm_x, arm_y = bearing_contact_arm(system, k, kinematics)
             add_contact_pair(system, k, q, generalized, ex, ey, nx, ny, fn, ft, arm_x, arm_y)
             friction_loss -= ft * sliding
-        if modes[k] != FREE and system.wear_harmonics[k] > 0:  # a second rim of a pocket tighter than the journal
+        if modes[k] != FREE and may_touch_two_rims(system, k):  # a second rim of a pocket tighter than the journal
             penetration, rate, nx, ny, sliding, arm_x, arm_y = second_rim(system, k, q, qd, ex, ey, dex, dey)
             fn, ft, elastic = second_rim_force_magnitudes(system, k, penetration, rate, sliding, impact_speeds[k])
             contact_loss += (fn - elastic) * rate
@@ -319,7 +334,7 @@ def add_wear_rates(system, q, qd, modes, impact_speeds, zdot):
         rates = zdot[slot:slot + 2 * harmonics + 1]
         for i in range(rates.shape[0]):
             rates[i] = 0.0
-        if modes[k] == FREE or (modes[k] == STICK and system.wear_harmonics[k] <= 0):
+        if modes[k] == FREE or (modes[k] == STICK and not may_touch_two_rims(system, k)):
             continue
         kinematics = clearance_kinematics(system, k, q, qd)
         ex, ey, dex, dey, penetration, rate, _, _, sliding = kinematics
@@ -328,7 +343,7 @@ def add_wear_rates(system, q, qd, modes, impact_speeds, zdot):
             if fn != 0.0:
                 arm_x, arm_y = bearing_contact_arm(system, k, kinematics)
                 add_contact_wear(system, k, q, rates, harmonics, fn, sliding, arm_x, arm_y)
-        if system.wear_harmonics[k] > 0:  # the second rim of a pocket tighter than the journal wears as well
+        if may_touch_two_rims(system, k):  # the second rim of a pocket tighter than the journal wears as well
             penetration, rate, _, _, sliding, arm_x, arm_y = second_rim(system, k, q, qd, ex, ey, dex, dey)
             fn = second_rim_force_magnitudes(system, k, penetration, rate, sliding, impact_speeds[k])[0]
             if fn != 0.0:
@@ -498,7 +513,7 @@ def potential_energy(system, q):
         p = system.clearance_params[k]
         energy += law_state(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT],
                             p[CL_CLEARANCE])[2]
-        if system.wear_harmonics[k] > 0:  # and the second rim's of a two-point contact
+        if may_touch_two_rims(system, k):  # and the second rim's of a two-point contact
             rim = second_rim(system, k, q, zero, ex, ey, 0.0, 0.0)[0]
             if rim > 0.0:
                 energy += law_state(system.clearance_laws[k, 3], rim, p[CL_STIFFNESS], p[CL_EXPONENT],

@@ -79,12 +79,12 @@ SystemArrays = namedtuple(
         "driveline_kinds", "driveline_bodies", "driveline_params", "driveline_table",  # assembly/drivelines.py
         "torsion_bodies", "torsion_params",
         "hydraulic_bodies", "hydraulic_params", "hydraulic_laws",
-        "wear_harmonics", "wear_profile", "wear_depth_range", "wear_bounds", "wear_slots", "wear_rates",  # worn bores, Archard wear (physics/wear.py)
+        "wear_harmonics", "wear_profile", "wear_samples", "wear_depth_range", "wear_bounds", "wear_slots", "wear_rates",  # worn bores, Archard wear (physics/wear.py)
         "row_place",  # each constraint row's place in the factor of S (see below)
     ],
     # force elements with states (assembly/hydraulics.py) and wear: none unless given
     defaults=(np.zeros((0, 2), np.int64), np.zeros((0, HYDRAULIC_COLUMNS)), np.zeros((0, HYDRAULIC_LAW_COLUMNS), np.int64),
-              np.zeros(0, np.int64), np.zeros((0, 1)), np.zeros(0), np.zeros((0, 2)), np.zeros((0, 2), np.int64), np.zeros((0, 2)),
+              np.zeros(0, np.int64), np.zeros((0, 1)), np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros((0, 2), np.int64), np.zeros((0, 2)),
               np.zeros(0, np.int64)),
 )
 # row_place[r]: the place of constraint row r in S and its factor (assembly/constraints.py schur_complement,
@@ -92,7 +92,9 @@ SystemArrays = namedtuple(
 # model's rows lie joint by joint along the chain (build.ConstraintRows.places), where pins, offsets, angles would put
 # the slides' rows after every pin and their envelope across the whole factor.
 # wear_harmonics[k]: M of joint k's worn profile (0: a circular bore), whose coefficients [a_0, a_1, b_1, ...] are the
-# start of the row wear_profile[k]; wear_depth_range[k] bounds its max − min (m; the nearest-point search's window);
+# start of the row wear_profile[k], and whose points r(2πk/N) (N = wear.sample_count(M)) start wear_samples[k] as
+# x_0, y_0, x_1, … (m; the nearest-point searches' samples, wear.bore_samples); wear_depth_range[k] bounds its
+# max − min (m; the nearest-point search's window);
 # wear_bounds[k]: (WEAR_REACH, WEAR_INNERMOST) lower bounds of its inner reach and of its smallest radius R_B + min h
 # (m; physics/wear.inner_reach, innermost_radius: nearer than the reach, the nearest point needs no search).
 # wear_slots[k]: (first slot in z of its accumulated Archard profile, −1: none;

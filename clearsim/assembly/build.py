@@ -305,7 +305,8 @@ def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: l
 
 
 def wear_arrays(parameters: list[ClearanceParameters], first_slot: int) -> dict:
-    """The wear_* arrays of the clearance joints (arrays.py): their worn profiles, and the slots in z (from
+    """The wear_* arrays of the clearance joints (arrays.py): their worn profiles and the bores' sampled points
+    (wear.bore_samples), and the slots in z (from
     first_slot on, after the cylinders' states) and rate factors of their Archard profiles."""
     count = len(parameters)
     profile_width = max([len(p.wear_profile) for p in parameters] + [1])
@@ -323,8 +324,13 @@ def wear_arrays(parameters: list[ClearanceParameters], first_slot: int) -> dict:
             rates[k, WEAR_LINE_STIFFNESS] = p.archard.line_stiffness
             rates[k, WEAR_WEIGHTS:WEAR_WEIGHTS + p.archard.harmonics + 1] = wear.kernel_weights(p.archard.sigma,
                                                                                              p.archard.harmonics)
+    samples = [wear.bore_samples(p.wear_profile, p.bearing_radius) if len(p.wear_profile) > 1 else np.zeros(2)
+               for p in parameters]
+    sampled = np.zeros((count, max([len(row) for row in samples] + [2])))
+    for k, row in enumerate(samples):
+        sampled[k, :len(row)] = row
     return {"wear_harmonics": np.array([(len(p.wear_profile) - 1) // 2 for p in parameters], np.int64).reshape(count),
-            "wear_profile": profile, "wear_depth_range": np.array([wear.depth_range(p.wear_profile) for p in parameters]),
+            "wear_profile": profile, "wear_samples": sampled, "wear_depth_range": np.array([wear.depth_range(p.wear_profile) for p in parameters]),
             "wear_bounds": np.array([(wear.inner_reach(p.wear_profile, p.bearing_radius),
                                       wear.innermost_radius(p.wear_profile, p.bearing_radius)) for p in parameters]
                                     ).reshape(count, 2),

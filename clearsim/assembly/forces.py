@@ -160,7 +160,7 @@ def kept_bore_points(system, k, local_x, local_y):
     if memo[0] != local_x or memo[1] != local_y or local_x == 0.0 or local_y == 0.0:
         p = system.clearance_params[k]
         found = system.bore_point(  # wear.nearest_bore_point, by address
-            system.wear_profile[k], system.wear_harmonics[k], system.wear_depth_range[k],
+            system.wear_profile[k], system.wear_samples[k], system.wear_harmonics[k], system.wear_depth_range[k],
             system.wear_bounds[k, WEAR_REACH], system.wear_bounds[k, WEAR_INNERMOST], p[CL_BEARING_RADIUS], local_x,
             local_y, second_rim_reach(system, k))
         memo[0], memo[1] = local_x, local_y

@@ -27,13 +27,14 @@ import numpy as np
 from numba import njit, types
 
 SAFEGUARDED_ITERATIONS = 60  # Newton converges quadratically (a step below NEWTON_TOLERANCE ends it); a bisection
-# step, taken when Newton would leave its bracket of 2π/(8M) either side, halves it (one below 1e-15 rad ends it)
+# step, taken when Newton would leave its bracket of one sample spacing either side, halves it (one below 1e-15 rad
+# ends it)
 NEWTON_TOLERANCE = 1e-12  # rad: the point after such a step is off by ~(g''/2g') 1e-24 plus the round-off of g, which
 # makes the steps jitter at ~ε R_B/|e| (5e-13 rad in a 0.01 mm joint of R_B = 50 mm): a smaller one is never reached
 WALK_SPACINGS = 4  # the longest step towards a minimum before its bracket, in sample spacings 2π/(8M)
 SMALLEST_SIGMA = 4.0  # σ ≥ 4/M: the truncated kernel's last weight is e^{-8} = 3e-4 of the first (no ringing)
-RIM_SPACING = math.pi / 64.0  # rad: the second rim's search samples at least this finely (a few harmonics' bore has
-# its rims tens of degrees apart, which the 2π/(8M) of its nearest-point search can step over)
+FEWEST_SAMPLES = 128  # the searches sample the bore every 2π/(8M), at least every π/64 (bore_samples): a few
+# harmonics' pocket has its rims tens of degrees apart, which 2π/(8M) could step over
 CONFORMAL_HALF_ANGLE = 0.5 * math.pi  # rad: a journal touches its bore within 90° of the load, however conformal
 
 
@@ -86,7 +87,8 @@ def _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, theta):
 
 
 @njit(cache=True)
-def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing_radius, ex, ey, within):
+def nearest_bore_point(coefficients, samples, harmonics, depth_range, reach, innermost, bearing_radius, ex, ey,
+                       within):
     """closest_bore_point, searching only where the nearest point is not certain, and the second rim of a two-point
     contact. A point inside the bore nearer to it than its inner reach (inner_reach) lies on the inward normal of
     exactly one bore point, which is its nearest, so the minimum of the distance Newton's method finds from the angle
@@ -94,11 +96,11 @@ def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, b
     on a bore nowhere tighter than the journal. Otherwise (e far from the wall, or a bore worn tighter than the
     journal somewhere, whose distance has several local minima: a two-point contact) a nearer point can only lie where
     ρ_min − |e| cos φ < d (φ = θ − θ_e; |r(θ) − e| ≥ ρ(θ) − |e| cos φ, ρ_min ≤ ρ = `innermost`), which narrows
-    search_window's window; that is searched as closest_bore_point does (searched_foot), and the nearer of its point
-    and Newton's kept. Where the reach is below `within` (the journal's radius: the bore may be tighter than the
-    journal) and that point is nearer than `within`, the nearest other minimum nearer than `within` is the second
-    rim the journal touches (second_foot; θ NaN where there is none). Returns (θ*, r_x, r_y, t_x, t_y, g') of the
-    nearest point, then the same of the second rim."""
+    search_window's window; that is searched as closest_bore_point does (searched_foot, on the bore's `samples`,
+    bore_samples), and the nearer of its point and Newton's kept. Where the reach is below `within` (the journal's
+    radius: the bore may be tighter than the journal) and that point is nearer than `within`, the nearest other
+    minimum nearer than `within` is the second rim the journal touches (second_foot; θ NaN where there is none).
+    Returns (θ*, r_x, r_y, t_x, t_y, g') of the nearest point, then the same of the second rim."""
     eccentricity = math.sqrt(ex * ex + ey * ey)
     start = math.atan2(ey, ex) if eccentricity > 0.0 else 0.0
     spacing = 2.0 * math.pi / (8.0 * max(harmonics, 1))
@@ -109,13 +111,13 @@ def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, b
     elif distance < math.inf:
         window = min(window, nearer_window(eccentricity, innermost, distance))
     if window > 0.0:
-        searched = searched_foot(coefficients, harmonics, window, bearing_radius, ex, ey, start, spacing)
+        searched = searched_foot(coefficients, samples, harmonics, window, bearing_radius, ex, ey, start)
         if not distance <= math.sqrt(_distance_squared(coefficients, harmonics, bearing_radius, ex, ey, searched)):
             theta = searched
     rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
     rim = math.nan
     if reach < within and (rx - ex) ** 2 + (ry - ey) ** 2 < within * within:
-        rim = second_foot(coefficients, harmonics, bearing_radius, ex, ey, start, min(spacing, RIM_SPACING),
+        rim = second_foot(coefficients, samples, harmonics, bearing_radius, ex, ey, start,
                           nearer_window(eccentricity, innermost, within), theta, within)
     rim_x, rim_y, rim_tx, rim_ty, rim_second = 0.0, 0.0, 0.0, 0.0, 0.0
     if rim == rim:
@@ -124,19 +126,21 @@ def nearest_bore_point(coefficients, harmonics, depth_range, reach, innermost, b
 
 
 @njit(cache=True)
-def second_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing, window, first, within):
+def second_foot(coefficients, samples, harmonics, bearing_radius, ex, ey, start, window, first, within):
     """θ of the nearest local minimum of |r(θ) − e| other than the one at `first` and nearer than `within`: the
-    second rim of a journal in a bore worn tighter than itself (NaN where there is none). The bore is sampled every
-    `spacing` over `window` round `start` (one sample more either side); each sampled local minimum more than 1.5
+    second rim of a journal in a bore worn tighter than itself (NaN where there is none). The bore's `samples`
+    (bore_samples) over `window` round `start` (one more either side); each sampled local minimum more than 1.5
     spacings from `first` is refined (refined_foot) and kept if it converges, more than half a spacing from `first`, to
     a minimum with e on the bore's inward side. Rims closer than that are one contact (the nearer)."""
-    samples = int(math.ceil(window / spacing)) + 1
+    count = sample_count(harmonics)
+    spacing = 2.0 * math.pi / count
+    lowest, highest = sampled_span(start, window, spacing)
     best, best_distance = math.nan, within
-    before = _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, start - (samples + 1) * spacing)
-    here = _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, start - samples * spacing)
-    for i in range(-samples, samples + 1):
-        after = _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, start + (i + 1) * spacing)
-        candidate = start + i * spacing
+    before = sampled_distance_squared(samples, count, lowest - 1, ex, ey)
+    here = sampled_distance_squared(samples, count, lowest, ex, ey)
+    for i in range(lowest, highest + 1):
+        after = sampled_distance_squared(samples, count, i + 1, ex, ey)
+        candidate = i * spacing
         if here <= before and here < after and abs(_wrapped(candidate - first)) > 1.5 * spacing:
             theta, converged = refined_foot(coefficients, harmonics, bearing_radius, ex, ey, candidate, spacing)
             if converged and abs(_wrapped(theta - first)) > 0.5 * spacing:
@@ -150,21 +154,52 @@ def second_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spacing,
 
 
 @njit(cache=True, inline="always")
+def sample_count(harmonics):
+    """N, the bore's sampled points (bore_samples): every 2π/(8M), at least every π/64 (FEWEST_SAMPLES)."""
+    return max(8 * harmonics, FEWEST_SAMPLES)
+
+
+@njit(cache=True, inline="always")
+def sampled_span(start, window, spacing):
+    """(first, last) indices of the samples k·spacing from `start` − `window` to `start` + `window` (rad), rounded
+    outwards."""
+    return int(math.floor((start - window) / spacing)), int(math.ceil((start + window) / spacing))
+
+
+@njit(cache=True, inline="always")
+def sampled_distance_squared(samples, count, index, ex, ey):
+    """|r(θ_k) − e|² at the sample k = index mod count of bore_samples' table."""
+    k = 2 * (index % count)
+    return (samples[k] - ex) ** 2 + (samples[k + 1] - ey) ** 2
+
+
+def bore_samples(coefficients, bearing_radius: float) -> np.ndarray:
+    """The bore's points r(θ_k) = (R_B + h(θ_k)) u(θ_k) at θ_k = 2πk/N, N = sample_count(M), as [x_0, y_0, x_1, y_1,
+    …] (m): the table the nearest-point and second-rim searches sample, built with the model (its profile is fixed
+    for a run), so that a sample costs a lookup instead of the M-term series."""
+    coefficients = np.asarray(coefficients, float)
+    harmonics = max((coefficients.shape[0] - 1) // 2, 0)
+    angles = 2.0 * math.pi * np.arange(sample_count(harmonics)) / sample_count(harmonics)
+    radii = bearing_radius + evaluate_profile(coefficients, angles)
+    return np.column_stack((radii * np.cos(angles), radii * np.sin(angles))).ravel()
+
+
+@njit(cache=True, inline="always")
 def _wrapped(angle):
     """angle in [−π, π)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
 # nearest_bore_point's type as the kernels call it by address (KernelArrays.bore_point, assembly/arrays.py): a row
-# of wear_profile, the harmonics, depth range, reach, innermost radius, R_B, e_x, e_y, the second rim's reach ->
+# of wear_profile and of wear_samples, the harmonics, depth range, reach, innermost radius, R_B, e_x, e_y, the second rim's reach ->
 # (θ*, r_x, r_y, t_x, t_y, g'') of the nearest point and of the second rim (θ NaN: none)
 BORE_POINT_TYPE = types.FunctionType(types.UniTuple(types.float64, 12)(
-    types.float64[::1], types.int64, types.float64, types.float64, types.float64, types.float64, types.float64,
+    types.float64[::1], types.float64[::1], types.int64, types.float64, types.float64, types.float64, types.float64, types.float64,
     types.float64, types.float64))
 
 
 @njit(cache=True)
-def no_bore_point(coefficients, harmonics, depth_range, reach, innermost, bearing_radius, ex, ey, within):
+def no_bore_point(coefficients, samples, harmonics, depth_range, reach, innermost, bearing_radius, ex, ey, within):
     """nearest_bore_point's stand-in for a model without worn bores, of the same type and never called (its kernels
     reach the worn-bore geometry only for a joint with harmonics > 0): such a model does not compile that geometry."""
     return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -188,18 +223,18 @@ def nearer_window(eccentricity, innermost, distance):
 
 
 @njit(cache=True)
-def closest_bore_point(coefficients, harmonics, depth_range, bearing_radius, ex, ey):
+def closest_bore_point(coefficients, samples, harmonics, depth_range, bearing_radius, ex, ey):
     """(θ*, r_x, r_y, r'_x, r'_y, g') of the bore point r(θ*) closest to e = (ex, ey), all in the bearing frame;
     g' = |r'|² + (r − e)·r'' is the curvature of |r(θ) − e|²/2 there (> 0 at a minimum; for the rate of θ*).
 
     The global minimum: a bore worn tighter than the journal's curvature somewhere has several local minima of the
     distance (a two-point contact) with a maximum between them, and Newton's method from the angle of e may stop on
-    either: searched_foot samples the window of search_window, where a nearer point can lie."""
+    either: searched_foot samples the window of search_window, where a nearer point can lie (`samples`:
+    bore_samples)."""
     eccentricity = math.sqrt(ex * ex + ey * ey)
     start = math.atan2(ey, ex) if eccentricity > 0.0 else 0.0
-    spacing = 2.0 * math.pi / (8.0 * max(harmonics, 1))
-    theta = searched_foot(coefficients, harmonics, search_window(eccentricity, depth_range), bearing_radius, ex, ey,
-                          start, spacing)
+    theta = searched_foot(coefficients, samples, harmonics, search_window(eccentricity, depth_range), bearing_radius,
+                          ex, ey, start)
     rx, ry, tx, ty, gradient, second = _bore_terms(coefficients, harmonics, bearing_radius, ex, ey, theta)
     return theta, rx, ry, tx, ty, second
 
@@ -233,19 +268,21 @@ def descended_foot(coefficients, harmonics, bearing_radius, ex, ey, start, spaci
 
 
 @njit(cache=True, inline="always")
-def searched_foot(coefficients, harmonics, window, bearing_radius, ex, ey, start, spacing):
-    """θ of the nearest point to e within `window` of the angle `start` of e: samples every `spacing` over the window
-    (none for a window 0) pick the nearest, refined_foot refines it."""
+def searched_foot(coefficients, samples, harmonics, window, bearing_radius, ex, ey, start):
+    """θ of the nearest point to e within `window` of the angle `start` of e: the nearest of the bore's `samples`
+    (bore_samples) over the window, rounded outwards to the samples (none for a window 0: `start`), refined by
+    refined_foot within one sample spacing either side."""
+    count = sample_count(harmonics)
+    spacing = 2.0 * math.pi / count
     theta = start
     if window > 0.0:
-        samples = int(math.ceil(window / spacing))
-        best, nearest = theta, _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, theta)
-        for i in range(-samples, samples + 1):
-            candidate = theta + i * spacing
-            distance = _distance_squared(coefficients, harmonics, bearing_radius, ex, ey, candidate)
+        lowest, highest = sampled_span(start, window, spacing)
+        best, nearest = lowest, math.inf
+        for i in range(lowest, highest + 1):
+            distance = sampled_distance_squared(samples, count, i, ex, ey)
             if distance < nearest:
-                best, nearest = candidate, distance
-        theta = best
+                best, nearest = i, distance
+        theta = best * spacing
     return refined_foot(coefficients, harmonics, bearing_radius, ex, ey, theta, spacing)[0]
 
 

@@ -73,7 +73,7 @@ FIELD_LAYOUT = {
     "driveline_table": ("f8", 2),
     "torsion_bodies": ("i8", 2), "torsion_params": ("f8", 2),
     "hydraulic_bodies": ("i8", 2), "hydraulic_params": ("f8", 2), "hydraulic_laws": ("i8", 2),
-    "wear_harmonics": ("i8", 1), "wear_profile": ("f8", 2), "wear_depth_range": ("f8", 1), "wear_bounds": ("f8", 2), "wear_slots": ("i8", 2), "wear_rates": ("f8", 2),
+    "wear_harmonics": ("i8", 1), "wear_profile": ("f8", 2), "wear_samples": ("f8", 2), "wear_depth_range": ("f8", 1), "wear_bounds": ("f8", 2), "wear_slots": ("i8", 2), "wear_rates": ("f8", 2),
     "row_place": ("i8", 1),
     "inverse_mass": ("f8", 1), "solve_blocks": ("f8", 3), "solve_bodies": ("i8", 2), "solve_schur": ("f8", 2),
     "solve_lower": ("f8", 2), "solve_envelope": ("i8", 1), "solve_band": ("i8", 1),

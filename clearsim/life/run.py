@@ -90,6 +90,8 @@ class Machine:
         does not complete."""
         loaded = self.worn(state)
         report = run_to_file(prepare(loaded), loaded, output, contents="summary")
+        if isinstance(report.error, KeyboardInterrupt):  # Ctrl-C or SIGTERM in the run stops the life, its rows kept:
+            raise KeyboardInterrupt                      # not a failed operation, whose block would be refused
         if not report.complete:
             raise WornOperationFailed(f"{self.loaded.path}: the operation with the bores worn to "
                             f"{', '.join(f'{j} {max_depth(s) * 1e3:.4g} mm' for j, s in state.items())} did not "

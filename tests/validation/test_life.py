@@ -130,3 +130,36 @@ def test_refused_predictions_leave_no_operation_files(pin_config, tmp_path, monk
     assert report.complete and failures["left"] == 0
     left = sorted(path.name for path in (tmp_path / "life-operations").iterdir())
     assert not [name for name in left if name.startswith("predicted")], left
+
+
+def test_a_ctrl_c_during_an_operation_stops_the_life_and_the_same_command_continues_it(pin_config, tmp_path,
+                                                                                     monkeypatch):
+    """Ctrl-C (or SIGTERM) mostly lands while an operation integrates, where the run catches it and writes its flagged
+    file: the life stops there with its rows kept and flagged interrupted, instead of refusing the block as if the
+    operation had failed and going on; the same command then continues it to the end."""
+    from clearsim.life import run
+
+    original, calls = run.run_to_file, {"count": 0}
+
+    def interrupted_fourth_run(system, loaded, output, **options):
+        calls["count"] += 1
+        if calls["count"] != 4:  # the second block's prediction (the first block: 0 → 4 020)
+            return original(system, loaded, output, **options)
+
+        def ctrl_c(time):
+            raise KeyboardInterrupt
+
+        return original(system, loaded, output, progress=ctrl_c, **options)
+
+    monkeypatch.setattr(run, "run_to_file", interrupted_fourth_run)
+    path = tmp_path / "life.h5"
+    with pytest.raises(KeyboardInterrupt):
+        run_life(LifeRequest(pin_config, OPERATIONS, path))
+    assert calls["count"] == 4
+    with h5py.File(path, "r") as life:
+        assert not life.attrs["complete"] and life.attrs["status"] == "interrupted"
+        kept = life["operations"][()].tolist()
+    assert 0 < kept[-1] < OPERATIONS
+    monkeypatch.setattr(run, "run_to_file", original)
+    report = run_life(LifeRequest(pin_config, OPERATIONS, path))
+    assert report.complete and report.resumed_from == kept[-1] and report.last.operations == OPERATIONS

@@ -202,8 +202,24 @@ def packed(fields: tuple, wear_harmonics: np.ndarray) -> KernelArrays:
 
 def _packed(fields, bore_point) -> KernelArrays:
     """_pack compiled (or loaded) for the field `bore_point` typed by its function type, not as the kernel given, so
-    that every model's KernelArrays has one type whichever kernel it holds."""
-    return _pack.compile((typeof(fields), BORE_POINT_TYPE))(fields, bore_point)
+    that every model's KernelArrays has one type whichever kernel it holds. Its entry point is kept per the fields'
+    array kinds (field_kinds): numba's typeof of the ~64 arrays takes ~0.4 ms, and a run packs its arrays four times
+    (the assembly's checks, the run)."""
+    kinds = field_kinds(fields)
+    entry = _pack_entries.get(kinds)
+    if entry is None:
+        entry = _pack_entries[kinds] = _pack.compile((typeof(fields), BORE_POINT_TYPE))
+    return entry(fields, bore_point)
+
+
+_pack_entries: dict = {}
+
+
+def field_kinds(fields: tuple) -> tuple:
+    """What numba's typeof reads of each array (its dtype, dimensions and flags: layout, writeable, aligned), as a
+    key; anything not an array by its type."""
+    return tuple((field.dtype, field.ndim, field.flags.num) if type(field) is np.ndarray else typeof(field)
+                 for field in fields)
 
 
 _numba_target_ready = False

@@ -120,7 +120,7 @@ def chunk_span(finest: float, last_span: float, simulated: float, wall: float) -
     at least `finest` (1 % of t_end) and at most GROWTH × the last span (the pace drops when impacts begin).
 
     A return costs ~0.25 ms (numba converts the kernels `advance` takes by address at every call, and copies the
-    samples): returning every 1 % would be most of a 30 ms run; this way a run returns a handful of times.
+    samples): returning every 1 % would be most of a 30 ms run; this way a run returns a handful of times."""
     if simulated <= 0.0 or wall <= 0.0:
         return finest
     return max(finest, min(GROWTH * last_span, simulated / wall * PROGRESS_SECONDS))

@@ -306,8 +306,8 @@ def pack(mechanism, rows: ConstraintRows, clearances: list, laws: Laws, loads: l
 
 def wear_arrays(parameters: list[ClearanceParameters], first_slot: int) -> dict:
     """The wear_* arrays of the clearance joints (arrays.py): their worn profiles and the bores' sampled points
-    (wear.bore_samples), and the slots in z (from
-    first_slot on, after the cylinders' states) and rate factors of their Archard profiles."""
+    (wear.bore_samples), and the slots in z (from first_slot on, after the cylinders' states) and rate factors of
+    their Archard profiles."""
     count = len(parameters)
     profile_width = max([len(p.wear_profile) for p in parameters] + [1])
     profile = np.zeros((count, profile_width))
@@ -330,7 +330,8 @@ def wear_arrays(parameters: list[ClearanceParameters], first_slot: int) -> dict:
     for k, row in enumerate(samples):
         sampled[k, :len(row)] = row
     return {"wear_harmonics": np.array([(len(p.wear_profile) - 1) // 2 for p in parameters], np.int64).reshape(count),
-            "wear_profile": profile, "wear_samples": sampled, "wear_depth_range": np.array([wear.depth_range(p.wear_profile) for p in parameters]),
+            "wear_profile": profile, "wear_samples": sampled,
+            "wear_depth_range": np.array([wear.depth_range(p.wear_profile) for p in parameters]),
             "wear_bounds": np.array([(wear.inner_reach(p.wear_profile, p.bearing_radius),
                                       wear.innermost_radius(p.wear_profile, p.bearing_radius)) for p in parameters]
                                     ).reshape(count, 2),

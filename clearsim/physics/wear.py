@@ -191,11 +191,11 @@ def _wrapped(angle):
 
 
 # nearest_bore_point's type as the kernels call it by address (KernelArrays.bore_point, assembly/arrays.py): a row
-# of wear_profile and of wear_samples, the harmonics, depth range, reach, innermost radius, R_B, e_x, e_y, the second rim's reach ->
-# (θ*, r_x, r_y, t_x, t_y, g'') of the nearest point and of the second rim (θ NaN: none)
+# of wear_profile and of wear_samples, the harmonics, depth range, reach, innermost radius, R_B, e_x, e_y, the
+# second rim's reach -> (θ*, r_x, r_y, t_x, t_y, g'') of the nearest point and of the second rim (θ NaN: none)
 BORE_POINT_TYPE = types.FunctionType(types.UniTuple(types.float64, 12)(
-    types.float64[::1], types.float64[::1], types.int64, types.float64, types.float64, types.float64, types.float64, types.float64,
-    types.float64, types.float64))
+    types.float64[::1], types.float64[::1], types.int64, types.float64, types.float64, types.float64, types.float64,
+    types.float64, types.float64, types.float64))
 
 
 @njit(cache=True)

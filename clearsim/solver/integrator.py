@@ -22,7 +22,8 @@ Compile time (docs/performance.md): numba compiles every kernel it calls as a li
 with all its callees linked in and optimised again. So five kernels are called by address: `advance` takes
 the mode switch, the projection, the model's dynamics (forces and constrained accelerations), the oil films' forces
 for the samples and the Rosenbrock step (solver.method: rosenbrock; linked into the loop it added ~10 s to a compile
-on an empty cache) as arguments typed as function types (`addressed_kernels`, `compiled_loop`) and passes the
+on an empty cache) in one structref whose fields are typed as function types (`addressed_kernels`,
+`loop_kernels`, `compiled_loop`; numba converts a function-type argument at every call, a field once) and passes the
 projection, the dynamics and the films on to the kernels that need them. A run that does not need the Rosenbrock
 step or the films passes a stand-in of the same type instead (`addressed`), so the same compiled loop never
 compiles them. Each is then compiled once, not into every library above it, and none has to be compiled before
@@ -37,6 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit, typeof, types
+from numba.experimental import structref
 
 from clearsim.assembly.arrays import (
     CL_CLEARANCE, CL_EXPONENT, CL_JOURNAL_RADIUS, CL_MIN_IMPACT_SPEED, CL_MU_D, CL_MU_S, CL_STIFFNESS, copy_into,
@@ -763,11 +765,13 @@ def refine_event(system, dynamics, projection, implicit_step, k, kind, t, y, f, 
 
 
 @njit(cache=True)
-def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, f, real, ints, modes, speeds, episode_of, log_joint,
-            log_onset, log_loss, log_speed, log_mass, peak_force, jacobian, jacobian_modes, out_t, out_y, out_modes,
-            out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies, t_stop):
+def advance(system, kernels, y, f, real, ints, modes, speeds, episode_of, log_joint, log_onset, log_loss, log_speed,
+            log_mass, peak_force, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd,
+            out_lam, out_contact, out_energies, t_stop):
     """Integrate until t_stop, the end, a full buffer, STEPS_PER_CALL tried steps or a failure; the status is
-    ints[I_STATUS]."""
+    ints[I_STATUS]. `kernels`: the LoopKernels the loop calls by address (loop_kernels)."""
+    mode_switch, projection, dynamics = kernels.mode_switch, kernels.projection, kernels.dynamics
+    films, implicit_step = kernels.films, kernels.implicit_step
     n = coordinate_count(system)
     stages = np.empty((dop853.STAGES if ints[I_METHOD] == DOP853 else STAGES, y.shape[0]))
     y_new = np.empty_like(y)
@@ -887,7 +891,7 @@ def advance(system, mode_switch, projection, dynamics, films, implicit_step, y, 
 
 def addressed(method: int, lubricated: bool) -> tuple:
     """The kernels `advance` takes by address for a run of `method` (DOPRI5, ROSENBROCK) of a model with or without
-    oil films (`lubricated`, dynamics.has_oil_films), in its argument order: the Rosenbrock step where it is the
+    oil films (`lubricated`, dynamics.has_oil_films), in LOOP_KERNEL_FIELDS' order: the Rosenbrock step where it is the
     method, else its stand-in of the same type (rosenbrock.not_taken, never called), so that only a run that takes the
     Rosenbrock step compiles it; likewise the dynamics and the sampling's film forces compile the oil films' kernels
     only for a lubricated model (dynamics_kernel, films_kernel). Every choice gives `advance` the same type."""
@@ -896,11 +900,11 @@ def addressed(method: int, lubricated: bool) -> tuple:
 
 
 def addressed_kernels(system_type, method: int, lubricated: bool) -> list:
-    """(kernel, numba function type) of each kernel `advance` takes by address, in its argument order.
+    """(kernel, numba function type) of each kernel `advance` takes by address, in LOOP_KERNEL_FIELDS' order.
 
     A kernel called by address is compiled once, as a library of its own, instead of being linked into (and
-    optimised again with) each library that calls it, and the caller's compilation does not wait for it. At the
-    loop's first call numba compiles or loads each one as it converts the argument, in this order; the compile-ahead
+    optimised again with) each library that calls it, and the caller's compilation does not wait for it. After
+    `advance` is typed the run compiles or loads each one, in this order (precompile.compile_addressed); the compile-ahead
     helper takes them in the reverse order (precompile.kernels_ahead), the largest first, so that on an empty cache
     the two processes share them and meet in the middle."""
     F, I, V, IV, M = types.float64, types.int64, types.float64[::1], types.int64[::1], types.float64[:, ::1]
@@ -919,21 +923,64 @@ def addressed_kernels(system_type, method: int, lubricated: bool) -> list:
     return [(kernel, types.FunctionType(signature[kernel])) for kernel in addressed(method, lubricated)]
 
 
+@structref.register
+class LoopKernelsType(types.StructRef):
+    def preprocess_fields(self, fields):
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)
+
+
+class LoopKernels(structref.StructRefProxy):
+    """The kernels `advance` calls by address (addressed), as one object: numba converts a kernel passed as a
+    function-type argument to its addresses at every call of the loop (two compile-result lookups each, ~0.25 ms for
+    the five); packed once per process, they are converted once."""
+
+
+LOOP_KERNEL_FIELDS = ["mode_switch", "projection", "dynamics", "films", "implicit_step"]  # addressed's order
+structref.define_proxy(LoopKernels, LoopKernelsType, LOOP_KERNEL_FIELDS)
+
+
+@njit(cache=True)
+def _pack_kernels(mode_switch, projection, dynamics, films, implicit_step):
+    return LoopKernels(mode_switch, projection, dynamics, films, implicit_step)
+
+
+def loop_kernels_type(system_type, method: int, lubricated: bool) -> LoopKernelsType:
+    """The numba type of loop_kernels' object: its fields typed as function types (addressed_kernels)."""
+    return LoopKernelsType([(name, kind) for name, (_, kind)
+                            in zip(LOOP_KERNEL_FIELDS, addressed_kernels(system_type, method, lubricated))])
+
+
+_packed_kernels: dict = {}
+
+
+def loop_kernels(system_type, method: int, lubricated: bool) -> LoopKernels:
+    """The kernels `advance` calls by address for a run of `method` of a model with or without oil films, packed
+    once per process (each compiled or loaded then, if it was not: precompile.compile_addressed first, on an empty
+    cache)."""
+    key = (system_type, method, lubricated)
+    if key not in _packed_kernels:
+        kinds = addressed_kernels(system_type, method, lubricated)
+        pack = _pack_kernels.compile(tuple(kind for _, kind in kinds))
+        _packed_kernels[key] = pack(*(kernel for kernel, _ in kinds))
+    return _packed_kernels[key]
+
+
 def loop_arguments(system, method: int, lubricated: bool, *state):
     """advance's arguments for a system's kernel arrays, the run's method, whether its model has oil films and its
     state arrays (and t_stop)."""
-    return (system, *addressed(method, lubricated), *state)
+    return (system, loop_kernels(typeof(system), method, lubricated), *state)
 
 
-def compiled_loop(arguments: tuple):
-    """`advance` for these arguments with the kernels it takes by address typed as function types
-    (addressed_kernels), compiled or loaded from the cache at the first call in a process; then nothing else is
-    compiled for it, so arguments of other types fail instead of compiling a second loop that links them in."""
+def compiled_loop(system_type, method: int, lubricated: bool, state: tuple):
+    """`advance` for a system of this type, a run of `method` with or without oil films and these state arguments,
+    with the kernels it takes by address typed as function types (loop_kernels_type), compiled or loaded from the
+    cache at the first call in a process, from the types alone: the kernels themselves are compiled after it
+    (precompile.compile_addressed), as on an empty cache the compile-ahead process does meanwhile. Then nothing else
+    is compiled for it, so arguments of other types fail instead of compiling a second loop that links them in."""
     global _loop_ready
     if not _loop_ready:
-        kinds = {id(kernel): kind for method in METHODS.values() for lubricated in (False, True)
-                 for kernel, kind in addressed_kernels(typeof(arguments[0]), method, lubricated)}
-        advance.compile(tuple(kinds.get(id(value)) or typeof(value) for value in arguments))
+        advance.compile((system_type, loop_kernels_type(system_type, method, lubricated),
+                         *(typeof(value) for value in state)))
         advance.disable_compile()
         _loop_ready = True
     return advance

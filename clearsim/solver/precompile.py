@@ -1,8 +1,9 @@
 """Compile ahead: on an empty kernel cache, a second process compiles part of the loop's kernels meanwhile.
 
-numba compiles in one thread per process. A run compiles the assembly's kernels, then `advance`, then, at the
+numba compiles in one thread per process. A run compiles the assembly's kernels, then `advance`, then, before the
 loop's first call, the kernels `advance` takes by address (integrator.addressed_kernels: the mode switch, the
-projection, the dynamics, the films' forces), one after the other in its argument order. When the cache holds no `advance`, the first
+projection, the dynamics, the films' forces), one after the other in their order (compile_addressed), and packs
+them for the loop (integrator.loop_kernels). When the cache holds no `advance`, the first
 run (`prepare`) starts `python -m clearsim.solver.precompile`, which compiles into the same cache the kernels the
 run's typing of `advance` needs early (`AHEAD`) and then those taken by address in the reverse order, the largest
 first (`kernels_ahead`): an explicit run's of a model without oil films (with the stand-ins of the Rosenbrock step and
@@ -95,7 +96,7 @@ def system_type():
 
 def kernels_ahead():
     """(dispatcher, full signature) of each kernel the helper compiles, in order: those of AHEAD, then the kernels
-    `advance` takes by address in the reverse of the order in which the run's first call of the loop converts them
+    `advance` takes by address in the reverse of the order in which the run compiles them (compile_addressed)
     (so that the two processes meet in the middle), by their function types' signatures (numba compiles, and keys in
     the cache, a kernel called by address by its signature with the return type)."""
     system = system_type()
@@ -216,7 +217,7 @@ _addressed_ready: set[tuple] = set()  # the (method, lubricated) whose kernels t
 
 def compile_addressed(kernel_arrays, method: int, lubricated: bool) -> None:
     """Before the loop's first call in a process: each kernel `advance` takes by address compiled here, or loaded from
-    the cache, in advance's argument order, as the call would convert them — except that one the helper is compiling
+    the cache, in their order (integrator.addressed_kernels) — except that one the helper is compiling
     at that moment is waited for and loaded, not compiled by both processes (where the two meet in the middle)."""
     if (method, lubricated) in _addressed_ready:
         return

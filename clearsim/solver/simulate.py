@@ -13,6 +13,7 @@ from dataclasses import dataclass, field, fields
 from typing import Callable, Iterator
 
 import numpy as np
+from numba import typeof
 
 from clearsim.assembly.arrays import (
     CL_BEARING_RADIUS, CL_JOURNAL_RADIUS, CL_MU_D, CL_MU_S, CL_STIFFNESS, for_kernels,
@@ -119,8 +120,8 @@ def chunk_span(finest: float, last_span: float, simulated: float, wall: float) -
     """Simulated time for the loop's next call: what it integrates in PROGRESS_SECONDS at the last call's pace,
     at least `finest` (1 % of t_end) and at most GROWTH × the last span (the pace drops when impacts begin).
 
-    A return costs ~0.25 ms (numba converts the kernels `advance` takes by address at every call, and copies the
-    samples): returning every 1 % would be most of a 30 ms run; this way a run returns a handful of times."""
+    A return costs ~10 µs (the call's arguments, the samples' copies): returning every 1 % would be 1 ms of a 30 ms
+    run; this way a run returns a handful of times."""
     if simulated <= 0.0 or wall <= 0.0:
         return finest
     return max(finest, min(GROWTH * last_span, simulated / wall * PROGRESS_SECONDS))
@@ -331,12 +332,12 @@ class Run:
     def _advance(self, t_stop: float) -> None:
         started = clock.perf_counter()
         method = int(self.ints[ig.I_METHOD])
-        arguments = ig.loop_arguments(self.kernel_arrays, method, self.lubricated, self.y, self.f, self.real, self.ints,
-                                      self.modes, self.speeds, self.episode_of, *self.log, self.peak_force, self.jacobian,
-                                      self.jacobian_modes, *self.buffers, t_stop)
-        loop = ig.compiled_loop(arguments)
+        state = (self.y, self.f, self.real, self.ints, self.modes, self.speeds, self.episode_of, *self.log,
+                 self.peak_force, self.jacobian, self.jacobian_modes, *self.buffers, t_stop)
+        system_type = typeof(self.kernel_arrays)
+        loop = ig.compiled_loop(system_type, method, self.lubricated, state)
         precompile.compile_addressed(self.kernel_arrays, method, self.lubricated)  # once per process, before a first call
-        loop(*arguments)
+        loop(self.kernel_arrays, ig.loop_kernels(system_type, method, self.lubricated), *state)
         if self.ints[ig.I_STATUS] == ig.FIRST_STEP:  # the first call: loads (or compiles) the loop, one rhs
             self.kernel_time += clock.perf_counter() - started
             self.kernels_compiled = precompile.compilations(self.loop_kernels) > self.compilations_before

@@ -1,8 +1,8 @@
-"""The loop calls its larger kernels by address (clearsim/solver/integrator.py `addressed_kernels`, `compiled_loop`,
-docs/performance.md *Compile time*): `advance` has one specialisation, whose arguments for the mode
-switch, the projection and the dynamics are function types, not the dispatchers' own types (which would link those
-kernels into it and into every kernel it passes them to), and it compiles nothing else, so arguments of another type
-fail at once."""
+"""The loop calls its larger kernels by address (clearsim/solver/integrator.py `addressed_kernels`, `loop_kernels`,
+`compiled_loop`, docs/performance.md *Compile time*): `advance` has one specialisation, whose kernels (the mode
+switch, the projection, the dynamics, the films, the Rosenbrock step) come in one object whose fields are function
+types, not the dispatchers' own types (which would link those kernels into it and into every kernel it passes them
+to), and it compiles nothing else, so arguments of another type fail at once."""
 
 import numpy as np
 import pytest
@@ -23,10 +23,16 @@ def test_advance_has_one_specialisation_taking_its_kernels_as_addresses(tmp_path
     system_type = typeof(for_kernels(prepare(load_mechanism(CRANK, [])).arrays))
     addressed = integrator.addressed_kernels(system_type, integrator.DOPRI5, False)
     assert signature[0] == system_type
-    assert {dynamics_type(system_type), integrator.projection_type(system_type)} <= set(signature)
-    assert list(signature[1:1 + len(addressed)]) == [kind for _, kind in addressed]
-    assert all(isinstance(kind, types.FunctionType) for kind in signature[1:1 + len(addressed)])
-    assert not any(isinstance(kind, types.FunctionType) for kind in signature[1 + len(addressed):])
+    kernels = signature[1]
+    assert isinstance(kernels, integrator.LoopKernelsType)
+    assert list(kernels.field_dict.values()) == [kind for _, kind in addressed]
+    assert all(isinstance(kind, types.FunctionType) for kind in kernels.field_dict.values())
+    assert {dynamics_type(system_type), integrator.projection_type(system_type)} <= set(kernels.field_dict.values())
+    assert not any(isinstance(kind, (types.FunctionType, integrator.LoopKernelsType)) for kind in signature[2:])
+    # every method and films choice packs kernels of that one type
+    for method in integrator.METHODS.values():
+        for lubricated in (False, True):
+            assert integrator.loop_kernels_type(system_type, method, lubricated) == kernels
 
 
 def _values_of(signature_types):
@@ -38,13 +44,13 @@ def _values_of(signature_types):
 def test_advance_refuses_arguments_of_another_type_instead_of_compiling_them(tmp_path):
     simulate_config(CRANK, ["solver.t_end=1ms"], tmp_path / "run.h5")
     (signature,) = integrator.advance.signatures
-    state = _values_of(signature[1 + len(integrator.addressed_kernels(signature[0], integrator.DOPRI5, False)):])
+    state = _values_of(signature[2:])
     state[0] = state[0].astype(np.float32)  # y of another dtype
     arguments = integrator.loop_arguments(for_kernels(prepare(load_mechanism(CRANK, [])).arrays), integrator.DOPRI5, False,
                                           *state)
     assert len(arguments) == len(signature)
     with pytest.raises(TypeError):
-        integrator.compiled_loop(arguments)(*arguments)
+        integrator.compiled_loop(signature[0], integrator.DOPRI5, False, tuple(arguments[2:]))(*arguments)
     assert integrator.advance.signatures == [signature]
 
 

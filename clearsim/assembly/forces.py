@@ -255,6 +255,13 @@ def contact_force_magnitudes(system, k, penetration, rate, sliding, mode, impact
 
 
 @njit(cache=True, inline="always")
+def contact_energy(system, k, penetration):
+    """∫ F_el dδ of clearance joint k's elastic law at penetration δ (law_state)."""
+    p = system.clearance_params[k]
+    return law_state(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT], p[CL_CLEARANCE])[2]
+
+
+@njit(cache=True, inline="always")
 def normal_force_magnitude(system, k, penetration, rate, impact_speed):
     """(F_n, F_el(δ)) of clearance joint k at δ > 0: its elastic law and damping (Meng 2015 eqs. 8–10)."""
     p = system.clearance_params[k]
@@ -510,12 +517,9 @@ def potential_energy(system, q):
         energy += 0.5 * p[0] * (angle - p[2]) ** 2 + p[3] * angle
     for k in range(system.clearance_bodies.shape[0]):
         ex, ey, _, _, penetration = clearance_kinematics(system, k, q, zero)[:5]
-        p = system.clearance_params[k]
-        energy += law_state(system.clearance_laws[k, 3], penetration, p[CL_STIFFNESS], p[CL_EXPONENT],
-                            p[CL_CLEARANCE])[2]
+        energy += contact_energy(system, k, penetration)
         if may_touch_two_rims(system, k):  # and the second rim's of a two-point contact
             rim = second_rim(system, k, q, zero, ex, ey, 0.0, 0.0)[0]
             if rim > 0.0:
-                energy += law_state(system.clearance_laws[k, 3], rim, p[CL_STIFFNESS], p[CL_EXPONENT],
-                                    p[CL_CLEARANCE])[2]
+                energy += contact_energy(system, k, rim)
     return energy + driveline_potential(system, q)

@@ -281,8 +281,8 @@ class Run:
         # the loop and the kernels it takes by address for this method and model (integrator.addressed: the
         # Rosenbrock step, the oil films' dynamics): whether numba compiled any of them for the loop's first call
         # (rather than loading it from the cache, or finding it in memory) is known once that call has returned
-        self.loop_kernels = (ig.advance, *ig.addressed(int(self.ints[ig.I_METHOD]), self.lubricated))
-        self.compilations_before = precompile.compilations(self.loop_kernels)
+        self.compiled_kernels = (ig.advance, *ig.addressed(int(self.ints[ig.I_METHOD]), self.lubricated))
+        self.compilations_before = precompile.compilations(self.compiled_kernels)
         self.kernels_compiled = False
         self.coordinate_count = n
         self.watched = (0, 0.0)  # tried steps and time where the stretch being watched began (judge_pace)
@@ -334,13 +334,12 @@ class Run:
         method = int(self.ints[ig.I_METHOD])
         state = (self.y, self.f, self.real, self.ints, self.modes, self.speeds, self.episode_of, *self.log,
                  self.peak_force, self.jacobian, self.jacobian_modes, *self.buffers, t_stop)
-        system_type = typeof(self.kernel_arrays)
-        loop = ig.compiled_loop(system_type, method, self.lubricated, state)
+        loop = ig.compiled_loop(typeof(self.kernel_arrays), method, self.lubricated, state)
         precompile.compile_addressed(self.kernel_arrays, method, self.lubricated)  # once per process, before a first call
-        loop(self.kernel_arrays, ig.loop_kernels(system_type, method, self.lubricated), *state)
+        loop(*ig.loop_arguments(self.kernel_arrays, method, self.lubricated, *state))
         if self.ints[ig.I_STATUS] == ig.FIRST_STEP:  # the first call: loads (or compiles) the loop, one rhs
             self.kernel_time += clock.perf_counter() - started
-            self.kernels_compiled = precompile.compilations(self.loop_kernels) > self.compilations_before
+            self.kernels_compiled = precompile.compilations(self.compiled_kernels) > self.compilations_before
             precompile.reap_helper()
         else:
             self.wall_time += clock.perf_counter() - started

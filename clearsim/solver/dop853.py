@@ -262,6 +262,23 @@ def extend(system, dynamics, t, y, h, modes, speeds, stages):
 
 
 @njit(cache=True)
+def attempt(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, extension):
+    """What the loop calls by address for a DOP853 run (integrator.addressed): a step (step's two error vectors), or,
+    with `extension`, the continuous extension's stages of the step just taken (extend; two empty vectors)."""
+    if extension:
+        extend(system, dynamics, t, y, h, modes, speeds, stages)
+        return np.empty(0), np.empty(0)
+    return step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new)
+
+
+@njit(cache=True)
+def not_taken(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, extension):
+    """attempt's stand-in, of its type, in the loop of a run of another method, which never calls it: such a run then
+    does not compile the DOP853 step (about 4 s of a first run's compile CPU)."""
+    return y_new, y_new
+
+
+@njit(cache=True)
 def combined_norm(high, low):
     """Hairer's error norm from the RMS norms of the 5th- and 3rd-order estimates: high²/√(high² + 0.01 low²)."""
     if high == 0.0 and low == 0.0:

@@ -19,13 +19,13 @@ Python (progress bar, writing, Ctrl-C); all its state lives in the arrays of `Ru
 at the top of the loop changes no result (tested with a return every 7 steps: every result file bitwise equal).
 
 Compile time (docs/performance.md): numba compiles every kernel it calls as a library of its own,
-with all its callees linked in and optimised again. So five kernels are called by address: `advance` takes
+with all its callees linked in and optimised again. So six kernels are called by address: `advance` takes
 the mode switch, the projection, the model's dynamics (forces and constrained accelerations), the oil films' forces
-for the samples and the Rosenbrock step (solver.method: rosenbrock; linked into the loop it added ~10 s to a compile
-on an empty cache) in one structref whose fields are typed as function types (`addressed_kernels`,
+for the samples, the Rosenbrock step (solver.method: rosenbrock; linked into the loop it added ~10 s to a compile
+on an empty cache) and the DOP853 step (solver.method: dop853; ~4 s of compile CPU linked in) in one structref whose fields are typed as function types (`addressed_kernels`,
 `loop_kernels`, `compiled_loop`; numba converts a function-type argument at every call, a field once) and passes the
 projection, the dynamics and the films on to the kernels that need them. A run that does not need the Rosenbrock
-step or the films passes a stand-in of the same type instead (`addressed`), so the same compiled loop never
+step, the DOP853 step or the films passes a stand-in of the same type instead (`addressed`), so the same compiled loop never
 compiles them. Each is then compiled once, not into every library above it, and none has to be compiled before
 `advance` is typed, so on an empty cache a second process compiles them meanwhile
 (clearsim/solver/precompile.py). A call by address is not inlined (the slider-crank's loop runs 6–9 % slower,
@@ -353,7 +353,7 @@ def projection_type(system_type):
 
 
 @njit(cache=True, inline="always")
-def emit_samples(system, dynamics, films, projection, implicit_step, t, y, f, stages, h, t_next, modes, speeds, episode_of,
+def emit_samples(system, dynamics, films, projection, implicit_step, high_order, t, y, f, stages, h, t_next, modes, speeds, episode_of,
                  real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact,
                  out_energies, scratch):
     """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives
@@ -369,7 +369,7 @@ def emit_samples(system, dynamics, films, projection, implicit_step, t, y, f, st
         chained = h > 0.0 and ints[I_METHOD] == ROSENBROCK and t < sample_time < t + h
         if chained:
             # a step of its own to the sample: the Hermite extension is not damped like the step (model.md §4)
-            ints[I_RHS] += method_step(system, dynamics, implicit_step, origin_t, origin_y, origin_f,
+            ints[I_RHS] += method_step(system, dynamics, implicit_step, high_order, origin_t, origin_y, origin_f,
                                        sample_time - origin_t, modes, speeds, np.empty_like(stages), scratch, real,
                                        ints, jacobian, jacobian_modes, False)[1]
         elif h > 0.0:
@@ -633,10 +633,10 @@ def update_output_peak(n, y, f, real):
 
 
 @njit(cache=True, inline="always")
-def method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stages, y_new, real, ints, jacobian,
-                jacobian_modes, take_jacobian):
-    """One step of the run's method (ints[I_METHOD]); ROSENBROCK: by address (rosenbrock.attempt), J taken anew first
-    when take_jacobian. Returns (the error norm, the rhs evaluations made, the error estimate e, the weight w that
+def method_step(system, dynamics, implicit_step, high_order, t, y, f, h, modes, speeds, stages, y_new, real, ints,
+                jacobian, jacobian_modes, take_jacobian):
+    """One step of the run's method (ints[I_METHOD]); ROSENBROCK and DOP853: by address (rosenbrock.attempt, J taken
+    anew first when take_jacobian; dop853.attempt). Returns (the error norm, the rhs evaluations made, the error estimate e, the weight w that
     makes w·e the estimate the norm measures: 1, or DOP853's combined over its 5th-order one)."""
     if ints[I_METHOD] == ROSENBROCK:
         error = implicit_step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian, jacobian_modes,
@@ -644,7 +644,7 @@ def method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stag
         taken = rosenbrock.jacobian_evaluations(jacobian_modes) if take_jacobian else 0
         return steering_norm(system, error, y, y_new, real, ints), rosenbrock.STAGES + taken, error, 1.0
     if ints[I_METHOD] == DOP853:
-        high, low = dop853.step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new)
+        high, low = high_order(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, False)
         high_norm = steering_norm(system, high, y, y_new, real, ints)
         norm = dop853.combined_norm(high_norm, steering_norm(system, low, y, y_new, real, ints))
         return norm, dop853.TRIAL_EVALUATIONS, high, norm / high_norm if high_norm > 0.0 else 0.0
@@ -706,12 +706,12 @@ def error_order(method):
 
 
 @njit(cache=True, inline="always")
-def extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints):
-    """The continuous extension's own stages of a step taken, where the method has them (DOP853); returns the rhs
-    evaluations made."""
+def extend_step(system, dynamics, high_order, t, y, h, modes, speeds, stages, ints):
+    """The continuous extension's own stages of a step taken, where the method has them (DOP853, by address:
+    dop853.attempt); returns the rhs evaluations made."""
     if ints[I_METHOD] != DOP853:
         return 0
-    dop853.extend(system, dynamics, t, y, h, modes, speeds, stages)
+    high_order(system, dynamics, t, y, y, h, modes, speeds, stages, y, True)
     return dop853.EXTENSION_EVALUATIONS
 
 
@@ -733,7 +733,7 @@ def jumped_across(system, dynamics, k, kind, t, y, stages, h, theta, modes, spee
 
 
 @njit(cache=True, inline="always")
-def refine_event(system, dynamics, projection, implicit_step, k, kind, t, y, f, h_event, h_limit, modes, speeds, stages,
+def refine_event(system, dynamics, projection, implicit_step, high_order, k, kind, t, y, f, h_event, h_limit, modes, speeds, stages,
                  y_event, real, ints, jacobian, jacobian_modes):
     """Integrate from t exactly to joint k's event; returns the step length.
 
@@ -747,7 +747,7 @@ def refine_event(system, dynamics, projection, implicit_step, k, kind, t, y, f, 
     tolerance = 1e-3 * hysteresis(system, k)
     widening = JUMP_WIDENING * h_event
     for _ in range(6):
-        ints[I_RHS] += method_step(system, dynamics, implicit_step, t, y, f, h_event, modes, speeds, stages, y_event,
+        ints[I_RHS] += method_step(system, dynamics, implicit_step, high_order, t, y, f, h_event, modes, speeds, stages, y_event,
                                    real, ints, jacobian, jacobian_modes, False)[1]
         projection(system, t + h_event, y_event, modes)
         if kind == TANGENTIAL:
@@ -771,7 +771,7 @@ def advance(system, kernels, y, f, real, ints, modes, speeds, episode_of, log_jo
     """Integrate until t_stop, the end, a full buffer, STEPS_PER_CALL tried steps or a failure; the status is
     ints[I_STATUS]. `kernels`: the LoopKernels the loop calls by address (loop_kernels)."""
     mode_switch, projection, dynamics = kernels.mode_switch, kernels.projection, kernels.dynamics
-    films, implicit_step = kernels.films, kernels.implicit_step
+    films, implicit_step, high_order = kernels.films, kernels.implicit_step, kernels.high_order
     n = coordinate_count(system)
     stages = np.empty((dop853.STAGES if ints[I_METHOD] == DOP853 else STAGES, y.shape[0]))
     y_new = np.empty_like(y)
@@ -811,7 +811,7 @@ def advance(system, kernels, y, f, real, ints, modes, speeds, episode_of, log_jo
             ints[I_RHS] += 1
             real[R_STEP] = min(real[R_STEP], switched)
         if ints[I_NEXT_SAMPLE] == 0:  # the first sample, in the modes the initial state has
-            emit_samples(system, dynamics, films, projection, implicit_step, t, y, f, stages, 0.0, t, modes, speeds,
+            emit_samples(system, dynamics, films, projection, implicit_step, high_order, t, y, f, stages, 0.0, t, modes, speeds,
                          episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
                          scratch)
         h = min(real[R_STEP], real[R_MAX_STEP], real[R_T_END] - t, free_flight_limit(system, y, modes))
@@ -822,7 +822,7 @@ def advance(system, kernels, y, f, real, ints, modes, speeds, episode_of, log_jo
                 return
             h = (capacity - 2) * real[R_SAMPLE_DT]
         take_jacobian = jacobian_due(ints, modes, jacobian_modes)
-        norm, evaluations, error, weight = method_step(system, dynamics, implicit_step, t, y, f, h, modes, speeds, stages,
+        norm, evaluations, error, weight = method_step(system, dynamics, implicit_step, high_order, t, y, f, h, modes, speeds, stages,
                                                        y_new, real, ints, jacobian, jacobian_modes, take_jacobian)
         norm = guarded_norm(system, norm, error, weight, y, y_new, modes, real, ints, scratch)
         ints[I_RHS] += evaluations
@@ -841,20 +841,20 @@ def advance(system, kernels, y, f, real, ints, modes, speeds, episode_of, log_jo
             continue
         real[R_STEP] = h * min(10.0, max(0.2, SAFETY * norm ** exponent)) if norm > 0.0 else 10.0 * h
         ints[I_JACOBIAN_AGE] += 1
-        ints[I_RHS] += extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints)
+        ints[I_RHS] += extend_step(system, dynamics, high_order, t, y, h, modes, speeds, stages, ints)
         fill_subdivisions(y, stages, h, points)
         event_theta, event_joint, event_kind = earliest_event(system, dynamics, t, y, y_new, stages, h, points,
                                                               kinematics, frictions, modes, speeds, scratch)
         if event_joint >= 0:
             jump = jumped_across(system, dynamics, event_joint, event_kind, t, y, stages, h, event_theta, modes, speeds,
                                  scratch)
-            h = refine_event(system, dynamics, projection, implicit_step, event_joint, event_kind, t, y, f,
+            h = refine_event(system, dynamics, projection, implicit_step, high_order, event_joint, event_kind, t, y, f,
                              event_theta * h, h if jump else event_theta * h, modes, speeds, stages, y_new, real, ints,
                              jacobian, jacobian_modes)
-            ints[I_RHS] += extend_step(system, dynamics, t, y, h, modes, speeds, stages, ints)
+            ints[I_RHS] += extend_step(system, dynamics, high_order, t, y, h, modes, speeds, stages, ints)
             fill_subdivisions(y, stages, h, points)  # the step integrated again, to the event
             fill_point_kinematics(system, y_new, points, modes, kinematics)
-        emit_samples(system, dynamics, films, projection, implicit_step, t, y, f, stages, h, t + h, modes, speeds,
+        emit_samples(system, dynamics, films, projection, implicit_step, high_order, t, y, f, stages, h, t + h, modes, speeds,
                      episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact, out_energies,
                      scratch)
         if event_joint < 0:  # projected after the samples: the step end's factor then serves its rhs below
@@ -890,13 +890,16 @@ def advance(system, kernels, y, f, real, ints, modes, speeds, episode_of, log_jo
 
 
 def addressed(method: int, lubricated: bool) -> tuple:
-    """The kernels `advance` takes by address for a run of `method` (DOPRI5, ROSENBROCK) of a model with or without
-    oil films (`lubricated`, dynamics.has_oil_films), in LOOP_KERNEL_FIELDS' order: the Rosenbrock step where it is the
-    method, else its stand-in of the same type (rosenbrock.not_taken, never called), so that only a run that takes the
-    Rosenbrock step compiles it; likewise the dynamics and the sampling's film forces compile the oil films' kernels
-    only for a lubricated model (dynamics_kernel, films_kernel). Every choice gives `advance` the same type."""
-    step_kernel = rosenbrock.attempt if method == ROSENBROCK else rosenbrock.not_taken
-    return (switch_mode, project_state, dynamics_kernel(lubricated), films_kernel(lubricated), step_kernel)
+    """The kernels `advance` takes by address for a run of `method` (METHODS) of a model with or without oil films
+    (`lubricated`, dynamics.has_oil_films), in LOOP_KERNEL_FIELDS' order: the Rosenbrock step and the DOP853 step where
+    each is the method, else its stand-in of the same type (rosenbrock.not_taken, dop853.not_taken, never called), so
+    that only a run that takes such a step compiles it; likewise the dynamics and the sampling's film forces compile
+    the oil films' kernels only for a lubricated model (dynamics_kernel, films_kernel). Every choice gives `advance`
+    the same type."""
+    implicit_step = rosenbrock.attempt if method == ROSENBROCK else rosenbrock.not_taken
+    high_order = dop853.attempt if method == DOP853 else dop853.not_taken
+    return (switch_mode, project_state, dynamics_kernel(lubricated), films_kernel(lubricated), implicit_step,
+            high_order)
 
 
 def addressed_kernels(system_type, method: int, lubricated: bool) -> list:
@@ -910,9 +913,12 @@ def addressed_kernels(system_type, method: int, lubricated: bool) -> list:
     F, I, V, IV, M = types.float64, types.int64, types.float64[::1], types.int64[::1], types.float64[:, ::1]
     dynamics, projection = dynamics_type(system_type), projection_type(system_type)
     implicit_step = V(system_type, dynamics, F, V, V, F, IV, V, M, V, M, IV, types.boolean, F)
+    high_order = types.Tuple((V, V))(system_type, dynamics, F, V, V, F, IV, V, M, V, types.boolean)
     signature = {
         rosenbrock.attempt: implicit_step,
         rosenbrock.not_taken: implicit_step,
+        dop853.attempt: high_order,
+        dop853.not_taken: high_order,
         switch_mode: F(system_type, dynamics, projection, I, I, F, V, IV, V, IV, V, IV, IV, V, V, V, V),
         project_state: projection.signature,
         forces_and_accelerations: dynamics.signature,
@@ -932,16 +938,16 @@ class LoopKernelsType(types.StructRef):
 class LoopKernels(structref.StructRefProxy):
     """The kernels `advance` calls by address (addressed), as one object: numba converts a kernel passed as a
     function-type argument to its addresses at every call of the loop (two compile-result lookups each, ~0.25 ms for
-    the five); packed once per process, they are converted once."""
+    five); packed once per process, they are converted once."""
 
 
-LOOP_KERNEL_FIELDS = ["mode_switch", "projection", "dynamics", "films", "implicit_step"]  # addressed's order
+LOOP_KERNEL_FIELDS = ["mode_switch", "projection", "dynamics", "films", "implicit_step", "high_order"]  # addressed's
 structref.define_proxy(LoopKernels, LoopKernelsType, LOOP_KERNEL_FIELDS)
 
 
 @njit(cache=True)
-def _pack_kernels(mode_switch, projection, dynamics, films, implicit_step):
-    return LoopKernels(mode_switch, projection, dynamics, films, implicit_step)
+def _pack_kernels(mode_switch, projection, dynamics, films, implicit_step, high_order):
+    return LoopKernels(mode_switch, projection, dynamics, films, implicit_step, high_order)
 
 
 def loop_kernels_type(system_type, method: int, lubricated: bool) -> LoopKernelsType:

@@ -73,6 +73,11 @@ def test_helper_then_run_compile_every_kernel_once_with_the_same_results(tmp_pat
     assert sorted(by_helper.keys() & by_run.keys()) == []  # the run loaded all the helper wrote
     step = "clearsim.solver.rosenbrock.attempt"
     assert step not in by_helper and step not in by_run  # an explicit run compiles no Rosenbrock step (its stand-in)
+    high_order = ("clearsim.solver.dop853.attempt", "clearsim.solver.dop853.step", "clearsim.solver.dop853.extend")
+    assert [name for name in high_order if name in by_helper or name in by_run] == []  # nor a DOP853 step
+    _, by_high_order = _compiled(env, CRANK, tmp_path / "high-order.h5", "solver.method=dop853")
+    assert all(by_high_order.get(name) == 1 for name in high_order)  # a DOP853 run compiles it
+    assert "clearsim.solver.integrator.advance" not in by_high_order  # for the same loop
     assert [name for name in FILM_KERNELS if name in by_helper or name in by_run] == []  # a dry model: no film kernel
     assert [name for name in BORE_KERNELS if name in by_helper or name in by_run] == []  # no worn bore: no geometry
     _, by_implicit = _compiled(env, CRANK, tmp_path / "implicit.h5", "solver.method=rosenbrock")

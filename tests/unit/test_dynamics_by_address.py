@@ -1,6 +1,6 @@
 """The loop calls its larger kernels by address (clearsim/solver/integrator.py `addressed_kernels`, `loop_kernels`,
 `compiled_loop`, docs/performance.md *Compile time*): `advance` has one specialisation, whose kernels (the mode
-switch, the projection, the dynamics, the films, the Rosenbrock step) come in one object whose fields are function
+switch, the projection, the dynamics, the films, the Rosenbrock step, the DOP853 step) come in one object whose fields are function
 types, not the dispatchers' own types (which would link those kernels into it and into every kernel it passes them
 to), and it compiles nothing else, so arguments of another type fail at once."""
 

@@ -22,11 +22,11 @@ Compile time (docs/performance.md): numba compiles every kernel it calls as a li
 with all its callees linked in and optimised again. So six kernels are called by address: `advance` takes
 the mode switch, the projection, the model's dynamics (forces and constrained accelerations), the oil films' forces
 for the samples, the Rosenbrock step (solver.method: rosenbrock; linked into the loop it added ~10 s to a compile
-on an empty cache) and the DOP853 step (solver.method: dop853; ~4 s of compile CPU linked in) in one structref whose fields are typed as function types (`addressed_kernels`,
-`loop_kernels`, `compiled_loop`; numba converts a function-type argument at every call, a field once) and passes the
-projection, the dynamics and the films on to the kernels that need them. A run that does not need the Rosenbrock
-step, the DOP853 step or the films passes a stand-in of the same type instead (`addressed`), so the same compiled loop never
-compiles them. Each is then compiled once, not into every library above it, and none has to be compiled before
+on an empty cache) and the DOP853 step (solver.method: dop853; ~4 s of compile CPU linked in) in one structref
+whose fields are typed as function types (`addressed_kernels`, `loop_kernels`, `compiled_loop`; numba converts a
+function-type argument at every call, a field once) and passes the projection, the dynamics and the films on to the
+kernels that need them. A run that does not need the Rosenbrock step, the DOP853 step or the films passes a
+stand-in of the same type instead (`addressed`), so the same compiled loop never compiles them. Each is then compiled once, not into every library above it, and none has to be compiled before
 `advance` is typed, so on an empty cache a second process compiles them meanwhile
 (clearsim/solver/precompile.py). A call by address is not inlined (the slider-crank's loop runs 6–9 % slower,
 the UHV's 2–5 %), so the parts called every step (the event search, the sampling, the peak search, the DOPRI
@@ -353,8 +353,8 @@ def projection_type(system_type):
 
 
 @njit(cache=True, inline="always")
-def emit_samples(system, dynamics, films, projection, implicit_step, high_order, t, y, f, stages, h, t_next, modes, speeds, episode_of,
-                 real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact,
+def emit_samples(system, dynamics, films, projection, implicit_step, high_order, t, y, f, stages, h, t_next, modes,
+                 speeds, episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact,
                  out_energies, scratch):
     """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives
     from them (derive_sample)."""
@@ -636,8 +636,9 @@ def update_output_peak(n, y, f, real):
 def method_step(system, dynamics, implicit_step, high_order, t, y, f, h, modes, speeds, stages, y_new, real, ints,
                 jacobian, jacobian_modes, take_jacobian):
     """One step of the run's method (ints[I_METHOD]); ROSENBROCK and DOP853: by address (rosenbrock.attempt, J taken
-    anew first when take_jacobian; dop853.attempt). Returns (the error norm, the rhs evaluations made, the error estimate e, the weight w that
-    makes w·e the estimate the norm measures: 1, or DOP853's combined over its 5th-order one)."""
+    anew first when take_jacobian; dop853.attempt). Returns (the error norm, the rhs evaluations made, the error
+    estimate e, the weight w that makes w·e the estimate the norm measures: 1, or DOP853's combined over its 5th-order
+    one)."""
     if ints[I_METHOD] == ROSENBROCK:
         error = implicit_step(system, dynamics, t, y, f, h, modes, speeds, stages, y_new, jacobian, jacobian_modes,
                               take_jacobian, real[R_ATOL] / real[R_RTOL])
@@ -733,8 +734,8 @@ def jumped_across(system, dynamics, k, kind, t, y, stages, h, theta, modes, spee
 
 
 @njit(cache=True, inline="always")
-def refine_event(system, dynamics, projection, implicit_step, high_order, k, kind, t, y, f, h_event, h_limit, modes, speeds, stages,
-                 y_event, real, ints, jacobian, jacobian_modes):
+def refine_event(system, dynamics, projection, implicit_step, high_order, k, kind, t, y, f, h_event, h_limit, modes,
+                 speeds, stages, y_event, real, ints, jacobian, jacobian_modes):
     """Integrate from t exactly to joint k's event; returns the step length.
 
     NORMAL events: Newton on the step length until |δ| < 1e-3 ε. TANGENTIAL events: the dense-output
@@ -747,8 +748,8 @@ def refine_event(system, dynamics, projection, implicit_step, high_order, k, kin
     tolerance = 1e-3 * hysteresis(system, k)
     widening = JUMP_WIDENING * h_event
     for _ in range(6):
-        ints[I_RHS] += method_step(system, dynamics, implicit_step, high_order, t, y, f, h_event, modes, speeds, stages, y_event,
-                                   real, ints, jacobian, jacobian_modes, False)[1]
+        ints[I_RHS] += method_step(system, dynamics, implicit_step, high_order, t, y, f, h_event, modes, speeds, stages,
+                                   y_event, real, ints, jacobian, jacobian_modes, False)[1]
         projection(system, t + h_event, y_event, modes)
         if kind == TANGENTIAL:
             if h_event >= h_limit or event_value(system, dynamics, k, kind, t + h_event, y_event, modes, speeds,
@@ -822,8 +823,9 @@ def advance(system, kernels, y, f, real, ints, modes, speeds, episode_of, log_jo
                 return
             h = (capacity - 2) * real[R_SAMPLE_DT]
         take_jacobian = jacobian_due(ints, modes, jacobian_modes)
-        norm, evaluations, error, weight = method_step(system, dynamics, implicit_step, high_order, t, y, f, h, modes, speeds, stages,
-                                                       y_new, real, ints, jacobian, jacobian_modes, take_jacobian)
+        norm, evaluations, error, weight = method_step(system, dynamics, implicit_step, high_order, t, y, f, h, modes,
+                                                       speeds, stages, y_new, real, ints, jacobian, jacobian_modes,
+                                                       take_jacobian)
         norm = guarded_norm(system, norm, error, weight, y, y_new, modes, real, ints, scratch)
         ints[I_RHS] += evaluations
         if take_jacobian:
@@ -848,8 +850,8 @@ def advance(system, kernels, y, f, real, ints, modes, speeds, episode_of, log_jo
         if event_joint >= 0:
             jump = jumped_across(system, dynamics, event_joint, event_kind, t, y, stages, h, event_theta, modes, speeds,
                                  scratch)
-            h = refine_event(system, dynamics, projection, implicit_step, high_order, event_joint, event_kind, t, y, f,
-                             event_theta * h, h if jump else event_theta * h, modes, speeds, stages, y_new, real, ints,
+            h = refine_event(system, dynamics, projection, implicit_step, high_order, event_joint, event_kind, t, y,
+                             f, event_theta * h, h if jump else event_theta * h, modes, speeds, stages, y_new, real, ints,
                              jacobian, jacobian_modes)
             ints[I_RHS] += extend_step(system, dynamics, high_order, t, y, h, modes, speeds, stages, ints)
             fill_subdivisions(y, stages, h, points)  # the step integrated again, to the event

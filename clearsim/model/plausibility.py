@@ -98,8 +98,8 @@ def _worn_pocket(joint, parameters, path: tuple) -> list[Problem]:
         return []
     return [Problem(path + ("wear", "profile"), f"the worn bore of joint '{joint.name}' has a pocket tighter than its "
                     f"journal ({pocket_words(tightest, parameters.journal_radius)}): the journal touches it at two "
-                    "points, and a friction law with exact sticking sticks at the nearer only, which makes the run "
-                    "crawl where the journal comes to rest in the pocket",
+                    "points, and a friction law with exact sticking treats the nearer alone exactly, which stalls the "
+                    "run where the journal lands on the pocket's axis, both points equally near",
                     "check the profile's units and harmonics: a journal wears a pocket at least as wide as itself "
                     "(fewer or smaller high harmonics widen it)")]
 

@@ -183,9 +183,9 @@ def mechanism_extent(system: System) -> float:
 
 def worn_pockets(system: System) -> list[str]:
     """In words (a list of one, or none): the clearance joints whose worn bore has a pocket tighter than the journal.
-    A journal pressed into it touches its two rims; a friction law with exact sticking sticks at the nearer only, so a
-    journal coming to rest there chatters between them (docs/model-contact.md, "A pocket tighter than the
-    journal")."""
+    A journal pressed into it touches its two rims; a friction law with exact sticking treats the nearer alone
+    exactly, so a journal landing within round-off of the pocket's axis, where the nearer rim changes with every
+    rounding, chatters between them (docs/model-contact.md, "A pocket tighter than the journal")."""
     arrays = system.arrays
     pockets = []
     for k, name in enumerate(system.clearance_joints):
@@ -198,8 +198,8 @@ def worn_pockets(system: System) -> list[str]:
     if not pockets:
         return []
     return [f"a worn bore with a pocket tighter than its journal at {', '.join(pockets)}: the journal touches the "
-            "pocket's two rims, and a friction law with exact sticking sticks at the nearer one only, so a journal "
-            "coming to rest there chatters between them; give `wear.profile` no pocket narrower than the journal "
+            "pocket's two rims, and a friction law with exact sticking treats the nearer one alone exactly, so a "
+            "journal landing on the pocket's axis, both rims equally near, chatters between them; give `wear.profile` no pocket narrower than the journal "
             "(R_B + h + h'' >= R_J everywhere: fewer or smaller high harmonics), or the friction `stick: smooth`"]
 
 

@@ -147,8 +147,9 @@ UHV = CONFIGS / "uhv_breaker.yaml"
 # journal pressed into it touches both rims (at A at 0.785 ms: 48° either side of the bottom, 8.8 and 8.3 µm deep)
 OVAL_POCKET = [f"joints.{joint}.wear.profile.cos=[0.02mm, 0, 0.02mm]" for joint in "AJ"]
 POCKET = "a worn bore with a pocket tighter than its journal at joint A (smallest radius of curvature 49.9601 mm"
-# a journal dropped into a pocket tighter than itself, damped, with exact sticking: coming to rest on the rims at
-# ~10 ms it sticks at the nearer one only and chatters between them until the steps reach min_step
+# a journal dropped onto the axis of a pocket tighter than itself, damped, with exact sticking: landing on both rims
+# at ~10 ms, equally near and sliding at them in opposite directions, the nearer rim changes with every rounding and
+# the steps reach min_step
 STICKING = "{law: stiction_step, mu_s: 0.2, mu_d: 0.15, v_s: 1e-4 m/s, v_d: 1e-2 m/s}"
 DAMPED = "{law: lankarani_nikravesh, restitution: 0.5, exponent: 1.5, stiffness: auto}"
 

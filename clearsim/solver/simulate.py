@@ -199,8 +199,9 @@ def worn_pockets(system: System) -> list[str]:
         return []
     return [f"a worn bore with a pocket tighter than its journal at {', '.join(pockets)}: the journal touches the "
             "pocket's two rims, and a friction law with exact sticking treats the nearer one alone exactly, so a "
-            "journal landing on the pocket's axis, both rims equally near, chatters between them; give `wear.profile` no pocket narrower than the journal "
-            "(R_B + h + h'' >= R_J everywhere: fewer or smaller high harmonics), or the friction `stick: smooth`"]
+            "journal landing on the pocket's axis, both rims equally near, chatters between them; give "
+            "`wear.profile` no pocket narrower than the journal (R_B + h + h'' >= R_J everywhere: fewer or smaller "
+            "high harmonics), or the friction `stick: smooth`"]
 
 
 def likely_causes(system: System, pace: Pace) -> list[str]:

@@ -26,11 +26,12 @@ on an empty cache) and the DOP853 step (solver.method: dop853; ~4 s of compile C
 whose fields are typed as function types (`addressed_kernels`, `loop_kernels`, `compiled_loop`; numba converts a
 function-type argument at every call, a field once) and passes the projection, the dynamics and the films on to the
 kernels that need them. A run that does not need the Rosenbrock step, the DOP853 step or the films passes a
-stand-in of the same type instead (`addressed`), so the same compiled loop never compiles them. Each is then compiled once, not into every library above it, and none has to be compiled before
-`advance` is typed, so on an empty cache a second process compiles them meanwhile
-(clearsim/solver/precompile.py). A call by address is not inlined (the slider-crank's loop runs 6–9 % slower,
-the UHV's 2–5 %), so the parts called every step (the event search, the sampling, the peak search, the DOPRI
-step) and the scalar helpers stay inlined by numba (inline="always"); kernels called many times per step stay
+stand-in of the same type instead (`addressed`), so the same compiled loop never compiles them. Each is then
+compiled once, not into every library above it, and none has to be compiled before `advance` is typed, so on an
+empty cache a second process compiles them meanwhile (clearsim/solver/precompile.py). A call by address is not
+inlined (the slider-crank's loop runs 6–9 % slower, the UHV's 2–5 %), so the parts called every step (the event
+search, the sampling, the peak search, the DOPRI step) and the scalar helpers stay inlined by numba
+(inline="always"); kernels called many times per step stay
 ordinary calls, since an inlined copy takes and releases a reference to each of its arrays.
 """
 
@@ -354,8 +355,8 @@ def projection_type(system_type):
 
 @njit(cache=True, inline="always")
 def emit_samples(system, dynamics, films, projection, implicit_step, high_order, t, y, f, stages, h, t_next, modes,
-                 speeds, episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds, out_episode, out_qdd, out_lam, out_contact,
-                 out_energies, scratch):
+                 speeds, episode_of, real, ints, jacobian, jacobian_modes, out_t, out_y, out_modes, out_speeds,
+                 out_episode, out_qdd, out_lam, out_contact, out_energies, scratch):
     """Write the samples with t < t_k <= t_next (and t_k = t at the very start), projected, with what derives
     from them (derive_sample)."""
     dt = real[R_SAMPLE_DT]

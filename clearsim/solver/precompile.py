@@ -6,8 +6,9 @@ projection, the dynamics, the films' forces), one after the other in their order
 them for the loop (integrator.loop_kernels). When the cache holds no `advance`, the first
 run (`prepare`) starts `python -m clearsim.solver.precompile`, which compiles into the same cache the kernels the
 run's typing of `advance` needs early (`AHEAD`) and then those taken by address in the reverse order, the largest
-first (`kernels_ahead`): an explicit run's of a model without oil films (with the stand-ins of the Rosenbrock step and
-of the films; a Rosenbrock run compiles its step itself, a lubricated model its dynamics and films). When the run reaches a kernel
+first (`kernels_ahead`): a DOPRI5 run's of a model without oil films (with the stand-ins of the Rosenbrock step, of
+the DOP853 step and of the films; a Rosenbrock or DOP853 run compiles its step itself, a lubricated model its dynamics
+and films). When the run reaches a kernel
 the helper has already written, numba loads it from the cache instead of compiling it (the same machine code: the
 cache is keyed by the sources and the signature), so the two processes meet in the middle of that list. Where they
 meet, the run waits for the kernel the helper is compiling at that moment (the helper names it in BUSY_NAME) and

@@ -280,7 +280,7 @@ class Run:
         self.wall_time = 0.0
         self.kernel_time = 0.0
         # the loop and the kernels it takes by address for this method and model (integrator.addressed: the
-        # Rosenbrock step, the oil films' dynamics): whether numba compiled any of them for the loop's first call
+        # Rosenbrock or DOP853 step, the oil films' dynamics): whether numba compiled any of them for the loop's first call
         # (rather than loading it from the cache, or finding it in memory) is known once that call has returned
         self.compiled_kernels = (ig.advance, *ig.addressed(int(self.ints[ig.I_METHOD]), self.lubricated))
         self.compilations_before = precompile.compilations(self.compiled_kernels)

@@ -4,6 +4,9 @@
     python -m benchmarks.step_trace --set joints.A.clearance=0.1mm --set joints.J.clearance=0.1mm
     python -m benchmarks.step_trace --csv steps.csv
 
+A run that fails stops the trace where it stops `clearsim run`, with the rows up to there, the run's message and exit
+code 2.
+
 The compiled loop is called once per accepted step (a return at the top of the loop changes no result), so each
 row has: the step h, the rejected tries before it, each clearance joint's mode (free / contact / stick / slide
 back), whether the step follows a mode switch, and for the step's first try (recomputed from the saved state) the
@@ -21,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import sys
 from collections import Counter
 from pathlib import Path
 
@@ -127,7 +131,10 @@ def jacobian_stability(jacobian_of, arrays, dynamics, t, y, f, h, tried, modes, 
             "jac_tried_R": float(max(abs(stability_function(tried * z)) for z in eigenvalues))}
 
 
-def trace(config: Path, overrides: list[str], jacobian_every: int = 0) -> tuple[list[dict], object]:
+def trace(config: Path, overrides: list[str], jacobian_every: int = 0) -> tuple[list[dict], object, Exception | None]:
+    """The rows of the run's accepted steps, the run, and the SolverError that stopped it early (None: it reached
+    t_end): a failure status of the loop or a hopeless pace (Run.judge_pace) stops the trace as it stops a run."""
+    from clearsim.errors import SolverError
     from clearsim.assembly.dynamics import WORK_COUNT, wear_state_count
     from clearsim.assembly.forces import FREE, clearance_kinematics
     from clearsim.model.loader import load_mechanism
@@ -155,6 +162,12 @@ def trace(config: Path, overrides: list[str], jacobian_every: int = 0) -> tuple[
         if status == ig.FIRST_STEP:
             run.real[ig.R_STEP] = _initial_step(system, run.y, run.f)
             continue
+        if status not in (ig.DONE, ig.CHUNK_END, ig.BUFFER_FULL, ig.PAUSED):
+            return rows, run, run._failure(status)
+        try:
+            run.judge_pace()
+        except SolverError as collapse:
+            return rows, run, collapse
         if run.time <= t:
             if status == ig.DONE:
                 break
@@ -192,7 +205,7 @@ def trace(config: Path, overrides: list[str], jacobian_every: int = 0) -> tuple[
         rows.append(row)
         if status == ig.DONE:
             break
-    return rows, run
+    return rows, run, None
 
 
 def band_crossings(rows: list[dict], bands: dict[str, tuple[float, float]]) -> list[dict]:
@@ -261,7 +274,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     from clearsim.assembly.arrays import CL_V_HIGH, CL_V_LOW
 
-    rows, run = trace(args.config, args.set, args.jacobian_every)
+    rows, run, stopped = trace(args.config, args.set, args.jacobian_every)
     joints = run.system.clearance_joints
     params = run.system.arrays.clearance_params
     bands = {j: (params[k, CL_V_LOW], params[k, CL_V_HIGH]) for k, j in enumerate(joints)}
@@ -272,6 +285,9 @@ def main(argv=None) -> int:
             writer = csv.DictWriter(handle, keys)
             writer.writeheader()
             writer.writerows(rows)
+    if stopped is not None:
+        print(f"the trace stops after {len(rows)} steps: {stopped}", file=sys.stderr)
+        return 2
     return 0
 
 

@@ -18,7 +18,9 @@ SHORT = ["solver.t_end=3ms"]
 
 @pytest.fixture(scope="module")
 def traced():
-    return trace(FRICTION, SHORT, jacobian_every=50)
+    rows, run, stopped = trace(FRICTION, SHORT, jacobian_every=50)
+    assert stopped is None
+    return rows, run
 
 
 def test_the_trace_accounts_for_every_step_and_rejection_of_the_run(traced):

@@ -16,12 +16,12 @@ import numpy as np
 from numba import typeof
 
 from clearsim.assembly.arrays import (
-    CL_BEARING_RADIUS, CL_JOURNAL_RADIUS, CL_MU_D, CL_MU_S, CL_STIFFNESS, for_kernels,
+    CL_BEARING_RADIUS, CL_JOURNAL_RADIUS, CL_MU_D, CL_MU_S, CL_STIFFNESS, CL_VISCOSITY, for_kernels,
 )
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints
 from clearsim.assembly.drivelines import puffer_overrun
-from clearsim.assembly.dynamics import WORK_COUNT, has_oil_films
-from clearsim.assembly.forces import FREE
+from clearsim.assembly.dynamics import WORK_COUNT, effective_mass, has_oil_films
+from clearsim.assembly.forces import FREE, clearance_kinematics, film_forces
 from clearsim.assembly.system import System
 from clearsim.errors import SolverError
 from clearsim.model.schema import SolverSettings
@@ -43,6 +43,10 @@ COLLAPSED = 1e-3  # a mean step below this fraction of the contact time t_c of a
 # with c = 0.5 mm, 1.5e13 for a 1 m one with c = 0.1 mm, 6.8e13 for 10 m with c = 0.5 mm)
 REALISTIC_STIFFNESS = 1e15
 HOPELESS_STEPS = 1e7  # tried steps still needed to reach t_end at the pace judged: a collapsed run stops, another warns
+# an explicit method's stability boundary on the negative real axis, |h λ| (DOPRI5's 3.3; DOP853's is larger, ≈ 6):
+# a film's squeeze damping b on the effective mass m, λ = −b/m, bounds the steps to ≈ EXPLICIT_BOUND · m/b
+EXPLICIT_BOUND = 3.3
+FILM_BOUND_FACTOR = 10.0  # steps within this factor below a film's bound are held by the film, not by the accuracy
 
 
 @dataclass
@@ -202,6 +206,49 @@ def worn_pockets(system: System) -> list[str]:
             "journal landing on the pocket's axis, both rims equally near, chatters between them; give "
             "`wear.profile` no pocket narrower than the journal (R_B + h + h'' >= R_J everywhere: fewer or smaller "
             "high harmonics), or the friction `stick: smooth`"]
+
+
+def squeeze_damping(system: System, kernel_arrays, k: int, q: np.ndarray, qd: np.ndarray,
+                    speed: float = 1e-6) -> float:
+    """N·s/m: b = ∂F_n/∂v_n of joint k's oil film at (q, q̇), its force along n against the journal's velocity along
+    the line of centres n (central difference of film_forces at ± `speed`; the film force is linear in the squeeze
+    rate ε̇ within a pressure region, docs/model-contact.md)."""
+    ex, ey = clearance_kinematics(kernel_arrays, k, q, qd)[:2]
+    eccentricity = np.hypot(ex, ey)
+    nx, ny = (ex / eccentricity, ey / eccentricity) if eccentricity > 0.0 else (1.0, 0.0)
+    journal = 3 * int(system.arrays.clearance_bodies[k, 1])
+    forces = []
+    for sign in (1.0, -1.0):
+        pushed = qd.copy()
+        pushed[journal] += sign * speed * nx
+        pushed[journal + 1] += sign * speed * ny
+        forces.append(film_forces(kernel_arrays, k, q, pushed)[0])
+    return abs(forces[0] - forces[1]) / (2.0 * speed)
+
+
+def stiff_films(system: System, kernel_arrays, y: np.ndarray, modes: np.ndarray, mean_step: float) -> list[str]:
+    """In words (a list of one, or none): the oil films carrying a journal whose squeeze damping b, on the joint's
+    effective mass m, bounds an explicit method's steps to ≈ 3.3 m/b, no more than tenfold above the steps taken, so
+    that the film, not the accuracy, sets them; `solver.method: rosenbrock` takes steps the accuracy sets
+    (docs/model.md §4)."""
+    if system.mechanism.solver.method == "rosenbrock":
+        return []
+    n = system.coordinate_count
+    q, qd = y[:n].copy(), y[n:2 * n].copy()
+    films = []
+    for k in np.flatnonzero((modes == FREE) & (system.arrays.clearance_params[:, CL_VISCOSITY] > 0.0)):
+        damping = squeeze_damping(system, kernel_arrays, int(k), q, qd)
+        mass = effective_mass(kernel_arrays, int(k), q, modes)
+        bound = EXPLICIT_BOUND * mass / damping if damping > 0.0 else np.inf
+        if mean_step * FILM_BOUND_FACTOR >= bound:  # the steps are near the film's bound (an explicit step cannot be far above it)
+            films.append(f"joint {system.clearance_joints[k]} (b = {damping:.3g} N·s/m on m = {mass:.3g} kg: "
+                         f"{bound:.2g} s)")
+    if not films:
+        return []
+    return [f"the oil film at {', '.join(films)}: its squeeze damping b on the joint's effective mass m bounds an "
+            f"explicit method's steps to ≈ {EXPLICIT_BOUND} m/b, and the steps ({mean_step:.2g} s) are held there, "
+            "not by the accuracy: set `solver: {method: rosenbrock}`, whose steps the accuracy sets (docs/performance.md, "
+            "\"Stiff models\")"]
 
 
 def likely_causes(system: System, pace: Pace) -> list[str]:
@@ -415,14 +462,21 @@ class Run:
                 f"step{scale}; at this pace the remaining {pace.remaining_time * 1e3:.4g} ms take "
                 f"{pace.remaining_steps:.2g} steps")
 
+    def _causes(self, pace: Pace) -> list[str]:
+        """Why the steps are this short: an oil film that holds an explicit method's steps (stiff_films, for a slow
+        run too), then, for a collapsed one, the model's likely causes (likely_causes)."""
+        films = stiff_films(self.system, self.kernel_arrays, self.y, self.modes, pace.mean_step)
+        return films + likely_causes(self.system, pace) if pace.collapsed else films
+
     def _pace_warning(self, pace: Pace) -> str:
         text = f"at t = {pace.time * 1e3:.4g} ms {self._pace_text(pace)}"
-        return f"{text}: likely causes: {'; '.join(likely_causes(self.system, pace))}" if pace.collapsed else text
+        causes = self._causes(pace)
+        return f"{text}: likely causes: {'; '.join(causes)}" if causes else text
 
     def _collapse(self, pace: Pace) -> SolverError:
         """A collapsed run as a failure: the joint, the time, the pace, the likely causes and the fix."""
         message = f"the steps collapsed far below the contact time, the run cannot reach t_end: {self._pace_text(pace)}"
-        hint = (f"likely causes: {'; '.join(likely_causes(self.system, pace))}. `clearsim validate` and `clearsim draw` "
+        hint = (f"likely causes: {'; '.join(self._causes(pace))}. `clearsim validate` and `clearsim draw` "
                 "show the mechanism as read")
         return SolverError(message, time=pace.time, element=self.system.clearance_joints[pace.joint], hint=hint)
 

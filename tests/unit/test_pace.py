@@ -183,3 +183,53 @@ def test_collapsed_steps_in_a_worn_pocket_give_the_pocket_as_the_first_likely_ca
     causes = sim.likely_causes(system, pace)
     assert causes[0].startswith(POCKET) and any("friction" in cause for cause in causes[1:])
     assert sim.likely_causes(prepare(load_mechanism(UHV)), pace)[0].startswith("friction")  # no pocket, no such cause
+
+
+# the bundled breaker greased at A and J: squeeze films of b = π μ R L³/(2 c³) = 9.82e8 N·s/m at a centred journal
+# (Ocvirk's short bearing, half-Sommerfeld: its pressure over the half circle ahead of the squeeze), which hold an
+# explicit method's steps at ~5 ns, where rosenbrock takes the stroke in 1 973 steps (docs/model.md §4 "Progress")
+GREASED = ["defaults.lubrication={viscosity: 0.1 Pa*s, length: 50 mm}"]
+
+
+@pytest.fixture(scope="module")
+def greased_run():
+    """The greased breaker after its first 10 µs (its journals near the bearings' centres), and the mean step."""
+    run = sim.Run(prepare(load_mechanism(UHV, GREASED + ["solver.t_end=10us"])))
+    for _ in run.chunks():
+        pass
+    return run, 10e-6 / tried_steps(run.statistics())
+
+
+def test_a_centred_journals_squeeze_damping_is_the_short_bearings_closed_form(greased_run):
+    run, _ = greased_run
+    n = run.system.coordinate_count
+    viscosity, radius, length, clearance = 0.1, 0.05, 0.05, 1e-5
+    for k in range(2):
+        damping = sim.squeeze_damping(run.system, run.kernel_arrays, k, run.y[:n].copy(), run.y[n:2 * n].copy())
+        assert damping == pytest.approx(np.pi * viscosity * radius * length**3 / (2 * clearance**3), rel=1e-3)
+
+
+def test_the_film_that_holds_an_explicit_runs_steps_is_named_with_the_fix(greased_run):
+    """J's film (m = 5.2 kg: 3.3 m/b = 17 ns) holds DOPRI5's ~5 ns steps; A's (m = 111 kg: 370 ns, 70× the steps) does
+    not; steps far below every film's bound, or a rosenbrock run, name none."""
+    run, mean_step = greased_run
+    assert 1e-9 < mean_step < 1e-8
+    (cause,) = sim.stiff_films(run.system, run.kernel_arrays, run.y, run.modes, mean_step)
+    assert "the oil film at joint J (b = 9.82e+08 N·s/m" in cause and "joint A" not in cause
+    assert "set `solver: {method: rosenbrock}`" in cause
+    assert sim.stiff_films(run.system, run.kernel_arrays, run.y, run.modes, mean_step / 100) == []
+    rosenbrock = prepare(load_mechanism(UHV, GREASED + ["solver.method=rosenbrock"]))
+    assert sim.stiff_films(rosenbrock, run.kernel_arrays, run.y, run.modes, mean_step) == []
+
+
+def test_a_run_held_by_an_oil_film_warns_with_the_film_and_rosenbrock():
+    """The greased stroke with DOPRI5 (1.6e7 steps left at the first judgement): the slow warning names J's film and
+    the method that takes its steps by the accuracy."""
+    warned = []
+    run = sim.Run(prepare(load_mechanism(UHV, GREASED)), warn=warned.append)
+    for _ in run.chunks():
+        if warned:
+            break
+    (text,) = warned
+    assert "at this pace the remaining" in text
+    assert "likely causes: the oil film at joint J" in text and "`solver: {method: rosenbrock}`" in text

@@ -240,15 +240,15 @@ def stiff_films(system: System, kernel_arrays, y: np.ndarray, modes: np.ndarray,
         damping = squeeze_damping(system, kernel_arrays, int(k), q, qd)
         mass = effective_mass(kernel_arrays, int(k), q, modes)
         bound = EXPLICIT_BOUND * mass / damping if damping > 0.0 else np.inf
-        if mean_step * FILM_BOUND_FACTOR >= bound:  # the steps are near the film's bound (an explicit step cannot be far above it)
+        if mean_step * FILM_BOUND_FACTOR >= bound:  # near the bound: an explicit run's steps cannot be far above it
             films.append(f"joint {system.clearance_joints[k]} (b = {damping:.3g} N·s/m on m = {mass:.3g} kg: "
                          f"{bound:.2g} s)")
     if not films:
         return []
-    return [f"the oil film at {', '.join(films)}: its squeeze damping b on the joint's effective mass m bounds an "
-            f"explicit method's steps to ≈ {EXPLICIT_BOUND} m/b, and the steps ({mean_step:.2g} s) are held there, "
-            "not by the accuracy: set `solver: {method: rosenbrock}`, whose steps the accuracy sets (docs/performance.md, "
-            "\"Stiff models\")"]
+    return [f"the oil film at {', '.join(films)}: a film's squeeze damping b on the joint's effective mass m bounds "
+            f"an explicit method's steps to ≈ {EXPLICIT_BOUND} m/b, and the steps ({mean_step:.2g} s) are held there, "
+            "not by the accuracy: set `solver: {method: rosenbrock}`, whose steps the accuracy sets "
+            "(docs/performance.md, \"Stiff models\")"]
 
 
 def likely_causes(system: System, pace: Pace) -> list[str]:

@@ -21,7 +21,7 @@ from clearsim.assembly.arrays import (
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints
 from clearsim.assembly.drivelines import puffer_overrun
 from clearsim.assembly.dynamics import WORK_COUNT, effective_mass, has_oil_films
-from clearsim.assembly.forces import FREE, clearance_kinematics, film_forces
+from clearsim.assembly.forces import FREE, clearance_kinematics, film_forces, second_rim
 from clearsim.assembly.system import System
 from clearsim.errors import SolverError
 from clearsim.model.schema import SolverSettings
@@ -185,14 +185,30 @@ def mechanism_extent(system: System) -> float:
     return float(np.max(np.ptp(positions, axis=0))) if len(positions) > 1 else 0.0
 
 
-def worn_pockets(system: System) -> list[str]:
-    """In words (a list of one, or none): the clearance joints whose worn bore has a pocket tighter than the journal.
-    A journal pressed into it touches its two rims; a friction law with exact sticking treats the nearer alone
-    exactly, so a journal landing within round-off of the pocket's axis, where the nearer rim changes with every
-    rounding, chatters between them (docs/model-contact.md, "A pocket tighter than the journal")."""
+def touching_two_rims(system: System, kernel_arrays, y: np.ndarray) -> set[int]:
+    """The clearance joints whose journal touches two rims of its worn bore at the state y (forces.second_rim)."""
+    n = system.coordinate_count
+    q, qd = y[:n].copy(), y[n:2 * n].copy()
+    touching = set()
+    for k in np.flatnonzero(system.arrays.wear_harmonics > 0):
+        ex, ey, dex, dey = clearance_kinematics(kernel_arrays, int(k), q, qd)[:4]
+        if second_rim(kernel_arrays, int(k), q, qd, ex, ey, dex, dey)[0] > 0.0:
+            touching.add(int(k))
+    return touching
+
+
+def worn_pockets(system: System, touching: set[int] | None = None) -> list[str]:
+    """In words (a list of one, or none): the clearance joints whose worn bore has a pocket tighter than the journal,
+    of them only those in `touching` when it is given (touching_two_rims: the run's state). A journal pressed into it
+    touches its two rims; a friction law with exact sticking treats the nearer alone exactly, so a journal landing
+    within round-off of the pocket's axis, where the nearer rim changes with every rounding, chatters between them
+    (docs/model-contact.md, "A pocket tighter than the journal"). A run that crawls or stops with no journal on two
+    rims does not do so for the pocket, whose journal may still rest in it on one rim."""
     arrays = system.arrays
     pockets = []
     for k, name in enumerate(system.clearance_joints):
+        if touching is not None and k not in touching:
+            continue
         harmonics = int(arrays.wear_harmonics[k])
         params = arrays.clearance_params[k]
         tightest = pocket_radius(arrays.wear_profile[k, :2 * harmonics + 1], params[CL_BEARING_RADIUS],
@@ -251,11 +267,12 @@ def stiff_films(system: System, kernel_arrays, y: np.ndarray, modes: np.ndarray,
             "(docs/performance.md, \"Stiff models\")"]
 
 
-def likely_causes(system: System, pace: Pace) -> list[str]:
+def likely_causes(system: System, pace: Pace, touching: set[int] | None = None) -> list[str]:
     """What in the model makes the steps this short, as far as its parameters tell: a worn pocket first (it makes
-    any contact in it crawl), then the joint's or the model's parameters."""
+    any contact in it crawl; only one a journal touches at two rims when `touching` is given, worn_pockets), then the
+    joint's or the model's parameters."""
     settings = system.mechanism.solver
-    causes = worn_pockets(system)
+    causes = worn_pockets(system, touching)
     if pace.joint >= 0:
         params = system.arrays.clearance_params[pace.joint]
         radius, extent = params[CL_BEARING_RADIUS], mechanism_extent(system)
@@ -466,7 +483,9 @@ class Run:
         """Why the steps are this short: an oil film that holds an explicit method's steps (stiff_films, for a slow
         run too), then, for a collapsed one, the model's likely causes (likely_causes)."""
         films = stiff_films(self.system, self.kernel_arrays, self.y, self.modes, pace.mean_step)
-        return films + likely_causes(self.system, pace) if pace.collapsed else films
+        if not pace.collapsed:
+            return films
+        return films + likely_causes(self.system, pace, touching_two_rims(self.system, self.kernel_arrays, self.y))
 
     def _pace_warning(self, pace: Pace) -> str:
         text = f"at t = {pace.time * 1e3:.4g} ms {self._pace_text(pace)}"
@@ -505,7 +524,7 @@ class Run:
         if overrun is not None:
             return SolverError(overrun[1], time=t, element=overrun[0], hint=overrun[2], kind="force")
         message, hint = messages[status]
-        pockets = worn_pockets(self.system)
+        pockets = worn_pockets(self.system, touching_two_rims(self.system, self.kernel_arrays, self.y))
         if status in (ig.MIN_STEP, ig.CHATTER) and pockets:
             hint = f"{'; '.join(pockets)}. Otherwise: {hint}"
         elif status == ig.MIN_STEP and all(mode == FREE for mode in self.modes):

@@ -43,8 +43,9 @@ COLLAPSED = 1e-3  # a mean step below this fraction of the contact time t_c of a
 # with c = 0.5 mm, 1.5e13 for a 1 m one with c = 0.1 mm, 6.8e13 for 10 m with c = 0.5 mm)
 REALISTIC_STIFFNESS = 1e15
 HOPELESS_STEPS = 1e7  # tried steps still needed to reach t_end at the pace judged: a collapsed run stops, another warns
-# an explicit method's stability boundary on the negative real axis, |h λ| (DOPRI5's 3.3; DOP853's is larger, ≈ 6):
-# a film's squeeze damping b on the effective mass m, λ = −b/m, bounds the steps to ≈ EXPLICIT_BOUND · m/b
+# an explicit method's stability boundary on the negative real axis, |h λ| (DOPRI5's 3.31; DOP853's 6.39, so that
+# its steps may reach twice the bound): a film's squeeze damping b on the effective mass m, λ = −b/m, bounds the
+# steps to ≈ EXPLICIT_BOUND · m/b
 EXPLICIT_BOUND = 3.3
 FILM_BOUND_FACTOR = 10.0  # steps within this factor below a film's bound are held by the film, not by the accuracy
 

@@ -21,7 +21,9 @@ from clearsim.assembly.arrays import (
 from clearsim.assembly.constraints import constraint_count, evaluate_constraints
 from clearsim.assembly.drivelines import puffer_overrun
 from clearsim.assembly.dynamics import WORK_COUNT, effective_mass, has_oil_films
-from clearsim.assembly.forces import FREE, clearance_kinematics, film_forces, second_rim
+from clearsim.assembly.forces import (
+    FREE, bearing_view, clearance_kinematics, film_forces, nearest_point_kept, second_rim,
+)
 from clearsim.assembly.system import System
 from clearsim.errors import SolverError
 from clearsim.model.schema import SolverSettings
@@ -48,6 +50,9 @@ HOPELESS_STEPS = 1e7  # tried steps still needed to reach t_end at the pace judg
 # steps to ≈ EXPLICIT_BOUND · m/b
 EXPLICIT_BOUND = 3.3
 FILM_BOUND_FACTOR = 10.0  # steps within this factor below a film's bound are held by the film, not by the accuracy
+# a journal nearer than this fraction of its penetration to the centre of curvature of its worn bore at the contact
+# point: the bore conforms to it there, and its one contact point is ill-conditioned (curvature_lever)
+CONFORMING = 0.1
 
 
 @dataclass
@@ -223,6 +228,40 @@ def worn_pockets(system: System, touching: set[int] | None = None) -> list[str]:
             "journal landing on the pocket's axis, both rims equally near, chatters between them; give "
             "`wear.profile` no pocket narrower than the journal (R_B + h + h'' >= R_J everywhere: fewer or smaller "
             "high harmonics), or the friction `stick: smooth`"]
+
+
+def curvature_lever(kernel_arrays, k: int, q: np.ndarray, qd: np.ndarray) -> tuple[float, float]:
+    """(ℓ, δ) in m of worn-bore joint k: ℓ = ρ_c − d, the distance from the journal's centre to the bore's centre of
+    curvature at the contact point (a shift s of the journal along the wall turns the contact normal by ≈ s/ℓ), from
+    the nearest-point search's g' = |r'|² + (r − e)·r'' = |r'|² (1 − d/ρ_c) and d = |r − e|; δ its penetration."""
+    ex, ey, dex, dey, penetration = clearance_kinematics(kernel_arrays, k, q, qd)[:5]
+    local_x, local_y = bearing_view(kernel_arrays, k, q, qd, ex, ey)[3:]
+    rx, ry, tx, ty, second = nearest_point_kept(kernel_arrays, k, local_x, local_y)
+    distance = np.hypot(rx - local_x, ry - local_y)
+    ratio = second / (tx * tx + ty * ty)  # 1 − d/ρ_c
+    return (distance * ratio / (1.0 - ratio) if ratio < 1.0 else np.inf), penetration
+
+
+def conforming_bores(system: System, kernel_arrays, y: np.ndarray, modes: np.ndarray) -> list[str]:
+    """In words (a list of one, or none): the worn-bore joints in contact whose journal lies nearer than CONFORMING
+    times its penetration to the bore's centre of curvature at the contact point (curvature_lever): a groove worn to
+    the loaded journal's shape, where the one contact point of the model is ill-conditioned (docs/model-contact.md,
+    "What the nearest-point contact leaves out")."""
+    n = system.coordinate_count
+    q, qd = y[:n].copy(), y[n:2 * n].copy()
+    found = []
+    for k in np.flatnonzero((system.arrays.wear_harmonics > 0) & (modes != FREE)):
+        lever, penetration = curvature_lever(kernel_arrays, int(k), q, qd)
+        if 0.0 < penetration and lever < CONFORMING * penetration:
+            found.append(f"joint {system.clearance_joints[k]} ({lever * 1e9:.3g} nm from it, "
+                         f"{penetration * 1e6:.3g} µm deep)")
+    if not found:
+        return []
+    return [f"a worn bore conforming to its journal at {', '.join(found)}: the journal rests near the centre of "
+            "curvature of the bore at its contact point, where the model's one contact point is ill-conditioned (a "
+            "shift s along the wall turns the contact normal by s/ℓ, ℓ that distance); a groove worn to the loaded "
+            "journal's shape does this: a wear band wider than the journal's imprint (`archard.width` left to its "
+            "default) or fewer harmonics keep it from forming"]
 
 
 def squeeze_damping(system: System, kernel_arrays, k: int, q: np.ndarray, qd: np.ndarray,
@@ -486,7 +525,8 @@ class Run:
         films = stiff_films(self.system, self.kernel_arrays, self.y, self.modes, pace.mean_step)
         if not pace.collapsed:
             return films
-        return films + likely_causes(self.system, pace, touching_two_rims(self.system, self.kernel_arrays, self.y))
+        return (films + conforming_bores(self.system, self.kernel_arrays, self.y, self.modes)
+                + likely_causes(self.system, pace, touching_two_rims(self.system, self.kernel_arrays, self.y)))
 
     def _pace_warning(self, pace: Pace) -> str:
         text = f"at t = {pace.time * 1e3:.4g} ms {self._pace_text(pace)}"
@@ -525,7 +565,8 @@ class Run:
         if overrun is not None:
             return SolverError(overrun[1], time=t, element=overrun[0], hint=overrun[2], kind="force")
         message, hint = messages[status]
-        pockets = worn_pockets(self.system, touching_two_rims(self.system, self.kernel_arrays, self.y))
+        pockets = (conforming_bores(self.system, self.kernel_arrays, self.y, self.modes)
+                   + worn_pockets(self.system, touching_two_rims(self.system, self.kernel_arrays, self.y)))
         if status in (ig.MIN_STEP, ig.CHATTER) and pockets:
             hint = f"{'; '.join(pockets)}. Otherwise: {hint}"
         elif status == ig.MIN_STEP and all(mode == FREE for mode in self.modes):

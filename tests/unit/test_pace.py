@@ -243,3 +243,53 @@ def test_a_run_held_by_an_oil_film_warns_with_the_film_and_rosenbrock():
     (text,) = warned
     assert "at this pace the remaining" in text
     assert "likely causes: the oil film at joint J" in text and "`solver: {method: rosenbrock}`" in text
+
+
+def oval_profile(theta):
+    """h, h', h'' of OVAL_POCKET's profile, 0.02 mm (1 + cos 2θ)."""
+    return 2e-5 * (1 + np.cos(2 * theta)), -4e-5 * np.sin(2 * theta), -8e-5 * np.cos(2 * theta)
+
+
+@pytest.fixture(scope="module")
+def pressed_oval():
+    """The oval-pocket breaker at 0.785 ms: A's journal pressed into its pocket."""
+    run = sim.Run(prepare(load_mechanism(UHV, OVAL_POCKET + ["solver.t_end=0.785ms"])))
+    for _ in run.chunks():
+        pass
+    return run
+
+
+def test_the_curvature_lever_is_the_distance_to_the_bores_centre_of_curvature_at_the_contact(pressed_oval):
+    """ℓ = ρ_c − d at the nearest bore point, against the reference geometry of tests/support/worn_bore (a dense
+    polygon, Newton's method, ρ_c = |r'|³/|r' × r''| of the explicitly differentiated profile)."""
+    from clearsim.assembly.forces import clearance_kinematics
+    from tests.support.worn_bore import _curve, bore_contacts, rotate
+
+    run = pressed_oval
+    n = run.system.coordinate_count
+    q, qd = run.y[:n].copy(), run.y[n:2 * n].copy()
+    lever, penetration = sim.curvature_lever(run.kernel_arrays, 0, q, qd)
+    ex, ey = clearance_kinematics(run.kernel_arrays, 0, q, qd)[:2]
+    bearing = int(run.system.arrays.clearance_bodies[0, 0])
+    local_e = rotate(-q[3 * bearing + 2], np.array([ex, ey]))
+    reference_depth, _, theta = bore_contacts(oval_profile, 0.05, 0.04999, local_e)[0]
+    r, first, second = _curve(oval_profile, 0.05, theta)
+    radius_of_curvature = np.hypot(*first) ** 3 / abs(first[0] * second[1] - first[1] * second[0])
+    assert penetration == pytest.approx(reference_depth, rel=1e-6)
+    assert lever == pytest.approx(radius_of_curvature - np.hypot(*(r - local_e)), rel=1e-6)
+    assert 0.0 < lever < 1e-3
+
+
+def test_a_journal_near_its_bores_centre_of_curvature_is_named_as_a_conforming_bore(pressed_oval, monkeypatch):
+    """A's journal pressed into the oval lies ℓ from the centre of curvature at its contact: named when ℓ is below
+    CONFORMING times its penetration (here with the factor raised above ℓ/δ), not otherwise; first among a stop's
+    causes."""
+    run = pressed_oval
+    n = run.system.coordinate_count
+    lever, penetration = sim.curvature_lever(run.kernel_arrays, 0, run.y[:n].copy(), run.y[n:2 * n].copy())
+    assert sim.conforming_bores(run.system, run.kernel_arrays, run.y, run.modes) == []
+    monkeypatch.setattr(sim, "CONFORMING", 1.01 * lever / penetration)
+    (cause,) = sim.conforming_bores(run.system, run.kernel_arrays, run.y, run.modes)
+    assert cause.startswith(f"a worn bore conforming to its journal at joint A ({lever * 1e9:.3g} nm from it")
+    assert "`archard.width`" in cause
+    assert str(run._failure(ig.MIN_STEP)).index("conforming") < str(run._failure(ig.MIN_STEP)).index("Otherwise")

@@ -191,10 +191,15 @@ def mechanism_extent(system: System) -> float:
     return float(np.max(np.ptp(positions, axis=0))) if len(positions) > 1 else 0.0
 
 
+def positions_and_rates(system: System, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Copies of q and q̇ of the integrator's state y, contiguous, as the kernels take them."""
+    n = system.coordinate_count
+    return y[:n].copy(), y[n:2 * n].copy()
+
+
 def touching_two_rims(system: System, kernel_arrays, y: np.ndarray) -> set[int]:
     """The clearance joints whose journal touches two rims of its worn bore at the state y (forces.second_rim)."""
-    n = system.coordinate_count
-    q, qd = y[:n].copy(), y[n:2 * n].copy()
+    q, qd = positions_and_rates(system, y)
     touching = set()
     for k in np.flatnonzero(system.arrays.wear_harmonics > 0):
         ex, ey, dex, dey = clearance_kinematics(kernel_arrays, int(k), q, qd)[:4]
@@ -234,7 +239,7 @@ def curvature_lever(kernel_arrays, k: int, q: np.ndarray, qd: np.ndarray) -> tup
     """(ℓ, δ) in m of worn-bore joint k: ℓ = ρ_c − d, the distance from the journal's centre to the bore's centre of
     curvature at the contact point (a shift s of the journal along the wall turns the contact normal by ≈ s/ℓ), from
     the nearest-point search's g' = |r'|² + (r − e)·r'' = |r'|² (1 − d/ρ_c) and d = |r − e|; δ its penetration."""
-    ex, ey, dex, dey, penetration = clearance_kinematics(kernel_arrays, k, q, qd)[:5]
+    ex, ey, _, _, penetration = clearance_kinematics(kernel_arrays, k, q, qd)[:5]
     local_x, local_y = bearing_view(kernel_arrays, k, q, qd, ex, ey)[3:]
     rx, ry, tx, ty, second = nearest_point_kept(kernel_arrays, k, local_x, local_y)
     distance = np.hypot(rx - local_x, ry - local_y)
@@ -247,8 +252,7 @@ def conforming_bores(system: System, kernel_arrays, y: np.ndarray, modes: np.nda
     times its penetration to the bore's centre of curvature at the contact point (curvature_lever): a groove worn to
     the loaded journal's shape, where the one contact point of the model is ill-conditioned (docs/model-contact.md,
     "What the nearest-point contact leaves out")."""
-    n = system.coordinate_count
-    q, qd = y[:n].copy(), y[n:2 * n].copy()
+    q, qd = positions_and_rates(system, y)
     found = []
     for k in np.flatnonzero((system.arrays.wear_harmonics > 0) & (modes != FREE)):
         lever, penetration = curvature_lever(kernel_arrays, int(k), q, qd)
@@ -289,8 +293,7 @@ def stiff_films(system: System, kernel_arrays, y: np.ndarray, modes: np.ndarray,
     (docs/model.md §4)."""
     if system.mechanism.solver.method == "rosenbrock":
         return []
-    n = system.coordinate_count
-    q, qd = y[:n].copy(), y[n:2 * n].copy()
+    q, qd = positions_and_rates(system, y)
     films = []
     for k in np.flatnonzero((modes == FREE) & (system.arrays.clearance_params[:, CL_VISCOSITY] > 0.0)):
         damping = squeeze_damping(system, kernel_arrays, int(k), q, qd)

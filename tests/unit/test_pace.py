@@ -293,3 +293,33 @@ def test_a_journal_near_its_bores_centre_of_curvature_is_named_as_a_conforming_b
     assert cause.startswith(f"a worn bore conforming to its journal at joint A ({lever * 1e9:.3g} nm from it")
     assert "`archard.width`" in cause
     assert str(run._failure(ig.MIN_STEP)).index("conforming") < str(run._failure(ig.MIN_STEP)).index("Otherwise")
+
+
+def test_a_journal_resting_at_its_grooves_centre_of_curvature_is_named_and_one_farther_is_not():
+    """A's bore worn to an oval h = a (1 + cos 2θ) whose bottom's radius of curvature ρ²/(ρ − ρ'') is R_J − 2 µm, and
+    A's journal put on the groove's axis ℓ from that centre (the journal body moved, nothing else): ℓ = 0.1 µm
+    (penetration 2.1 µm) is named as a conforming bore, ℓ = 1 µm (3 µm) is not; curvature_lever finds both ℓ."""
+    from scipy.optimize import brentq
+
+    from clearsim.assembly.forces import clearance_kinematics
+    from tests.support.worn_bore import rotate
+
+    bearing_radius, journal_radius, rest = 0.05, 0.04999, 2e-6
+    bottom_curvature = lambda a: (bearing_radius + 2 * a) ** 2 / (bearing_radius + 2 * a + 4 * a)  # noqa: E731
+    depth = brentq(lambda a: bottom_curvature(a) - (journal_radius - rest), 1e-7, 1e-4)
+    run = sim.Run(prepare(load_mechanism(UHV, [f"joints.A.wear.profile.cos=[{depth!r} m, 0, {depth!r} m]"])))
+    n = run.system.coordinate_count
+    bearing, journal = (int(body) for body in run.system.arrays.clearance_bodies[0])
+    for lever, named in ((1e-7, True), (1e-6, False)):
+        y = run.y.copy()
+        ex, ey = clearance_kinematics(run.kernel_arrays, 0, y[:n].copy(), y[n:2 * n].copy())[:2]
+        local = np.array([bearing_radius + 2 * depth - bottom_curvature(depth) + lever, 0.0])
+        target = rotate(y[3 * bearing + 2], local)
+        y[3 * journal:3 * journal + 2] += target - np.array([ex, ey])
+        found, penetration = sim.curvature_lever(run.kernel_arrays, 0, y[:n].copy(), y[n:2 * n].copy())
+        assert found == pytest.approx(lever, rel=1e-4)
+        assert penetration == pytest.approx(rest + lever, rel=1e-6)
+        causes = sim.conforming_bores(run.system, run.kernel_arrays, y, np.array([1, 0]))
+        assert bool(causes) is named
+        if named:
+            assert causes[0].startswith(f"a worn bore conforming to its journal at joint A ({lever * 1e9:.3g} nm")

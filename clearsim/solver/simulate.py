@@ -27,7 +27,7 @@ from clearsim.assembly.forces import (
 from clearsim.assembly.system import System
 from clearsim.errors import SolverError
 from clearsim.model.schema import SolverSettings
-from clearsim.physics.wear import pocket_radius, pocket_words
+from clearsim.physics.wear import bore_curvature_radius, pocket_radius, pocket_words
 from clearsim.solver import integrator as ig
 from clearsim.solver import precompile
 from clearsim.solver.outputs import hertz_durations, output_acceleration_point, output_rate
@@ -235,16 +235,19 @@ def worn_pockets(system: System, touching: set[int] | None = None) -> list[str]:
             "high harmonics), or the friction `stick: smooth`"]
 
 
-def curvature_lever(kernel_arrays, k: int, q: np.ndarray, qd: np.ndarray) -> tuple[float, float]:
+def curvature_lever(system: System, kernel_arrays, k: int, q: np.ndarray,
+                    qd: np.ndarray) -> tuple[float, float]:
     """(ℓ, δ) in m of worn-bore joint k: ℓ = ρ_c − d, the distance from the journal's centre to the bore's centre of
-    curvature at the contact point (a shift s of the journal along the wall turns the contact normal by ≈ s/ℓ), from
-    the nearest-point search's g' = |r'|² + (r − e)·r'' = |r'|² (1 − d/ρ_c) and d = |r − e|; δ its penetration."""
+    curvature at the contact point (a shift s of the journal along the wall turns the contact normal by ≈ s/ℓ), with
+    ρ_c the bore's radius of curvature there (wear.bore_curvature_radius) and d = |r − e| its distance from the
+    journal's centre; δ its penetration."""
     ex, ey, _, _, penetration = clearance_kinematics(kernel_arrays, k, q, qd)[:5]
     local_x, local_y = bearing_view(kernel_arrays, k, q, qd, ex, ey)[3:]
-    rx, ry, tx, ty, second = nearest_point_kept(kernel_arrays, k, local_x, local_y)
-    distance = np.hypot(rx - local_x, ry - local_y)
-    ratio = second / (tx * tx + ty * ty)  # 1 − d/ρ_c
-    return (distance * ratio / (1.0 - ratio) if ratio < 1.0 else np.inf), penetration
+    rx, ry = nearest_point_kept(kernel_arrays, k, local_x, local_y)[:2]
+    arrays = system.arrays
+    radius = bore_curvature_radius(arrays.wear_profile[k], arrays.wear_harmonics[k],
+                                   arrays.clearance_params[k, CL_BEARING_RADIUS], np.arctan2(ry, rx))
+    return radius - np.hypot(rx - local_x, ry - local_y), penetration
 
 
 def conforming_bores(system: System, kernel_arrays, y: np.ndarray, modes: np.ndarray) -> list[str]:
@@ -255,7 +258,7 @@ def conforming_bores(system: System, kernel_arrays, y: np.ndarray, modes: np.nda
     q, qd = positions_and_rates(system, y)
     found = []
     for k in np.flatnonzero((system.arrays.wear_harmonics > 0) & (modes != FREE)):
-        lever, penetration = curvature_lever(kernel_arrays, int(k), q, qd)
+        lever, penetration = curvature_lever(system, kernel_arrays, int(k), q, qd)
         if 0.0 < penetration and lever < CONFORMING * penetration:
             found.append(f"joint {system.clearance_joints[k]} ({lever * 1e9:.3g} nm from it, "
                          f"{penetration * 1e6:.3g} µm deep)")

@@ -268,7 +268,7 @@ def test_the_curvature_lever_is_the_distance_to_the_bores_centre_of_curvature_at
     run = pressed_oval
     n = run.system.coordinate_count
     q, qd = run.y[:n].copy(), run.y[n:2 * n].copy()
-    lever, penetration = sim.curvature_lever(run.kernel_arrays, 0, q, qd)
+    lever, penetration = sim.curvature_lever(run.system, run.kernel_arrays, 0, q, qd)
     ex, ey = clearance_kinematics(run.kernel_arrays, 0, q, qd)[:2]
     bearing = int(run.system.arrays.clearance_bodies[0, 0])
     local_e = rotate(-q[3 * bearing + 2], np.array([ex, ey]))
@@ -285,8 +285,8 @@ def test_a_journal_near_its_bores_centre_of_curvature_is_named_as_a_conforming_b
     CONFORMING times its penetration (here with the factor raised above ℓ/δ), not otherwise; first among a stop's
     causes."""
     run = pressed_oval
-    n = run.system.coordinate_count
-    lever, penetration = sim.curvature_lever(run.kernel_arrays, 0, run.y[:n].copy(), run.y[n:2 * n].copy())
+    q, qd = sim.positions_and_rates(run.system, run.y)
+    lever, penetration = sim.curvature_lever(run.system, run.kernel_arrays, 0, q, qd)
     assert sim.conforming_bores(run.system, run.kernel_arrays, run.y, run.modes) == []
     monkeypatch.setattr(sim, "CONFORMING", 1.01 * lever / penetration)
     (cause,) = sim.conforming_bores(run.system, run.kernel_arrays, run.y, run.modes)
@@ -316,7 +316,8 @@ def test_a_journal_resting_at_its_grooves_centre_of_curvature_is_named_and_one_f
         local = np.array([bearing_radius + 2 * depth - bottom_curvature(depth) + lever, 0.0])
         target = rotate(y[3 * bearing + 2], local)
         y[3 * journal:3 * journal + 2] += target - np.array([ex, ey])
-        found, penetration = sim.curvature_lever(run.kernel_arrays, 0, y[:n].copy(), y[n:2 * n].copy())
+        q, qd = sim.positions_and_rates(run.system, y)
+        found, penetration = sim.curvature_lever(run.system, run.kernel_arrays, 0, q, qd)
         assert found == pytest.approx(lever, rel=1e-4)
         assert penetration == pytest.approx(rest + lever, rel=1e-6)
         causes = sim.conforming_bores(run.system, run.kernel_arrays, y, np.array([1, 0]))
